@@ -1,0 +1,36 @@
+"""Warp initialisation and device resolution shared by every solver.
+
+Warp is initialised lazily and quietly the first time a solver needs it, so that
+importing :mod:`blastfrac` (for example to validate a scenario) stays cheap.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import warp as wp
+
+F64 = wp.float64
+
+
+@functools.cache
+def init_warp() -> None:
+    """Initialise Warp once, without its start-up banner."""
+    wp.config.quiet = True
+    wp.init()
+
+
+def resolve_device(name: str | None) -> str:
+    """Return a Warp device string for ``name`` ("cpu", "cuda", "cuda:0", None → cpu).
+
+    Raises ``ValueError`` with a user-facing message when a CUDA device is asked for
+    but none is available.
+    """
+    init_warp()
+    if name is None or name == "cpu":
+        return "cpu"
+    if name.startswith("cuda"):
+        if not wp.is_cuda_available():
+            raise ValueError(f"device '{name}' requested but no CUDA device is available; use device='cpu'")
+        return "cuda:0" if name == "cuda" else name
+    raise ValueError(f"unknown device '{name}': expected 'cpu', 'cuda' or 'cuda:N'")
