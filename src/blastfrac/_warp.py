@@ -7,6 +7,8 @@ importing :mod:`blastfrac` (for example to validate a scenario) stays cheap.
 from __future__ import annotations
 
 import functools
+import os
+import sys
 
 import warp as wp
 
@@ -16,8 +18,18 @@ F64 = wp.float64
 @functools.cache
 def init_warp() -> None:
     """Initialise Warp once, without its start-up banner."""
-    wp.config.quiet = True
-    wp.init()
+    wp.config.log_level = wp.LOG_WARNING
+    # Warp's native layer prints a warning on machines without a CUDA driver; CPU runs are the
+    # normal case here, so hide that one message by muting file descriptor 2 during init.
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 2)
+            wp.init()
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def resolve_device(name: str | None) -> str:

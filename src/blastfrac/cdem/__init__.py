@@ -1,0 +1,1 @@
+"""Continuum–discontinuum element method for the rock: kernels and solver."""

@@ -1,0 +1,63 @@
+"""CDEM solver: the ordered rock stages of one explicit step. Holds no physical state."""
+
+from __future__ import annotations
+
+import numpy as np
+import warp as wp
+
+from ..model.model import Model, State
+from .boundary import launch_edge_loads
+from .contact import BlockContact
+from .kernels_element import launch_element_forces, launch_gather_springs
+from .kernels_integrate import launch_integrate
+from .kernels_spring import launch_spring_forces
+
+
+class CDEMSolver:
+    """Rock forces and integration for a :class:`Model`; scratch buffers are allocated once here."""
+
+    def __init__(self, model: Model, block_contact: bool | None = None):
+        self.model = model
+        n = max(1, len(model.pulses))
+        self._pulse_host = wp.zeros(n, dtype=wp.float64, device="cpu", pinned=model.device != "cpu")
+        use_contact = model.breakable == 1 if block_contact is None else block_contact
+        self.contact = BlockContact(model) if use_contact else None
+        self.dt_prev = 0.0
+
+    def set_pulses(self, state: State, t: float) -> None:
+        """Evaluate every pressure pulse at time t [s] and copy the values to the device."""
+        if not self.model.pulses:
+            return
+        host = self._pulse_host.numpy()
+        for i, p in enumerate(self.model.pulses):
+            host[i] = p(t)
+        wp.copy(state.pulse_values, self._pulse_host)
+
+    def forces(self, state: State, dt: float, t: float) -> None:
+        """Stage 3 of a step: element stresses and forces, springs with failure, loads, block contact."""
+        launch_spring_forces(self.model, state, dt, t)            # 3a springs, failure, broken-pair contact
+        launch_element_forces(self.model, state, dt)              # 3b CST stress update, f = f_int
+        launch_gather_springs(self.model, state)                  # 3c f += spring forces (gather)
+        self.set_pulses(state, t)
+        launch_edge_loads(self.model, state, self.dt_prev)        # 3d pressure pulses, in-situ tractions
+        if self.contact is not None:
+            self.contact.apply(state, dt)                         # 3e node-to-edge block contact
+
+    def integrate(self, state: State, dt: float, alpha: float = 0.0) -> None:
+        """Stage 4: central difference with damping, constraints and dashpots."""
+        launch_integrate(self.model, state, dt, alpha)
+        self.dt_prev = dt
+
+    def initialise_stress(self, state: State, sxx: float, syy: float, sxy: float) -> None:
+        """Uniform initial stress σ⁰ in all blocks and consistent spring forces (METHOD §1.8)."""
+        m = self.model
+        sig = np.array([[sxx, sxy], [sxy, syy]])
+        state.sigma.assign(np.tile([sxx, syy, sxy], (m.element_count, 1)))
+        nrm = np.repeat(m.host["iface_normal"], 2, axis=0)
+        tan = np.stack([-nrm[:, 1], nrm[:, 0]], 1)
+        traction = nrm @ sig                                  # σ·n (σ symmetric)
+        ac = m.host["pair_ac"]
+        fn = -np.einsum("ij,ij->i", nrm, traction) * ac
+        fs = -np.einsum("ij,ij->i", tan, traction) * ac
+        state.pair_F.assign(np.stack([fn, fs], 1))
+        state.pair_g0.assign(fn / m.host["pair_kn"])

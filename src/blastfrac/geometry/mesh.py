@@ -1,0 +1,188 @@
+"""Triangle meshes of rock domains: gmsh generation and .msh import.
+
+A :class:`TriMesh` is the shared-vertex mesh as a mesher produces it (vertices, CCW
+triangles, tagged boundary edges). The CDEM builder later splits it into blocks that
+each own their nodes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..scenario.schema import DiscDomain, GeometryConfig, PolygonDomain, RectangleDomain
+
+
+@dataclass
+class TriMesh:
+    """Shared-vertex triangle mesh.
+
+    vertices: coordinates [m], shape [V, 2]
+    triangles: vertex indices, counter-clockwise, shape [E, 3]
+    boundary_edges: vertex index pairs of boundary segments, shape [B, 2]
+    boundary_tags: side name of each boundary edge ('left', 'outer', 'hole0', ...), length B
+    """
+
+    vertices: np.ndarray
+    triangles: np.ndarray
+    boundary_edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    boundary_tags: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.vertices = np.ascontiguousarray(self.vertices[:, :2], dtype=np.float64)
+        tri = np.ascontiguousarray(self.triangles, dtype=np.int64)
+        area = signed_areas(self.vertices, tri)
+        if np.any(area == 0):
+            raise ValueError(f"mesh has {int(np.sum(area == 0))} degenerate triangles")
+        flip = area < 0
+        tri[flip] = tri[flip][:, [0, 2, 1]]
+        self.triangles = tri
+        self.boundary_edges = np.asarray(self.boundary_edges, dtype=np.int64).reshape(-1, 2)
+
+    @property
+    def element_count(self) -> int:
+        return len(self.triangles)
+
+    def edge_lengths(self) -> np.ndarray:
+        """Lengths of the three edges of every triangle [m], shape [E, 3] (edge k joins k and k+1)."""
+        p = self.vertices[self.triangles]
+        return np.linalg.norm(p[:, [1, 2, 0]] - p, axis=2)
+
+
+def signed_areas(vertices: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    p = vertices[triangles]
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def generate_mesh(geom: GeometryConfig, seed: int = 0) -> TriMesh:
+    """Mesh ``geom`` with gmsh (deterministic for a given seed), or read ``geom.mesh_file``."""
+    if geom.mesh_file is not None:
+        return read_msh(geom.mesh_file)
+    import gmsh
+
+    initialised_here = not gmsh.isInitialized()
+    if initialised_here:
+        gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.model.add("blastfrac")
+        return _mesh_with_gmsh(gmsh, geom, seed)
+    finally:
+        gmsh.model.remove()
+        if initialised_here:
+            gmsh.finalize()
+
+
+def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
+    g = gmsh.model.geo
+    h = geom.mesh_size
+    h_near = geom.mesh_size_near or h
+    side_curves: dict[str, list[int]] = {}
+
+    def polyline(points: list[tuple[float, float]], names: list[str]) -> int:
+        tags = [g.addPoint(x, y, 0.0, h) for x, y in points]
+        lines = []
+        for i, name in enumerate(names):
+            ln = g.addLine(tags[i], tags[(i + 1) % len(tags)])
+            side_curves.setdefault(name, []).append(ln)
+            lines.append(ln)
+        return g.addCurveLoop(lines)
+
+    def circle(center: tuple[float, float], r: float, name: str, size: float, reverse: bool) -> int:
+        c = g.addPoint(center[0], center[1], 0.0, size)
+        pts = [g.addPoint(center[0] + r * math.cos(a), center[1] + r * math.sin(a), 0.0, size)
+               for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
+        arcs = [g.addCircleArc(pts[i], c, pts[(i + 1) % 4]) for i in range(4)]
+        side_curves.setdefault(name, []).extend(arcs)
+        loop = [-a for a in reversed(arcs)] if reverse else arcs
+        return g.addCurveLoop(loop)
+
+    d = geom.domain
+    if isinstance(d, RectangleDomain):
+        cx, cy, w2, h2 = d.center[0], d.center[1], d.width / 2, d.height / 2
+        outer = polyline([(cx - w2, cy - h2), (cx + w2, cy - h2), (cx + w2, cy + h2), (cx - w2, cy + h2)],
+                         ["bottom", "right", "top", "left"])
+    elif isinstance(d, DiscDomain):
+        outer = circle(d.center, d.radius, "outer", h, reverse=False)
+    elif isinstance(d, PolygonDomain):
+        outer = polyline(list(d.vertices), [f"side{i}" for i in range(len(d.vertices))])
+    else:  # pragma: no cover - the schema admits no other type
+        raise TypeError(type(d))
+
+    holes = [circle(b.center, b.radius, f"hole{i}", b.mesh_size or h_near, reverse=True)
+             for i, b in enumerate(geom.boreholes)]
+    g.addPlaneSurface([outer, *holes])
+    g.synchronize()
+
+    if geom.boreholes and h_near < h:
+        hole_curves = [c for i in range(len(geom.boreholes)) for c in side_curves[f"hole{i}"]]
+        dist = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(dist, "CurvesList", hole_curves)
+        gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
+        thr = gmsh.model.mesh.field.add("Threshold")
+        rmax = max(b.radius for b in geom.boreholes)
+        gmsh.model.mesh.field.setNumber(thr, "InField", dist)
+        gmsh.model.mesh.field.setNumber(thr, "SizeMin", h_near)
+        gmsh.model.mesh.field.setNumber(thr, "SizeMax", h)
+        gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
+        gmsh.model.mesh.field.setNumber(thr, "DistMax", geom.refinement_distance or 10.0 * rmax)
+        gmsh.model.mesh.field.setAsBackgroundMesh(thr)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+    gmsh.option.setNumber("Mesh.Algorithm", 5 if geom.mesh_algorithm == "delaunay" else 6)
+    gmsh.option.setNumber("Mesh.RandomSeed", 1.0 + seed)
+    gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
+    gmsh.model.mesh.generate(2)
+
+    node_tags, coords, _ = gmsh.model.mesh.getNodes()
+    xy = coords.reshape(-1, 3)[:, :2]
+    tag_to_row = np.full(int(node_tags.max()) + 1, -1, np.int64)
+    tag_to_row[node_tags.astype(np.int64)] = np.arange(len(node_tags))
+    _, elem_nodes = gmsh.model.mesh.getElementsByType(2)
+    tri = tag_to_row[elem_nodes.astype(np.int64)].reshape(-1, 3)
+    bedges, btags = [], []
+    for name, curves in side_curves.items():
+        for c in curves:
+            types, _, enodes = gmsh.model.mesh.getElements(1, c)
+            for t, en in zip(types, enodes):
+                if t == 1:
+                    e = tag_to_row[en.astype(np.int64)].reshape(-1, 2)
+                    bedges.append(e)
+                    btags.extend([name] * len(e))
+    return _compact(xy, tri, np.concatenate(bedges) if bedges else np.zeros((0, 2), np.int64), btags)
+
+
+def _compact(xy: np.ndarray, tri: np.ndarray, bedges: np.ndarray, btags: list[str]) -> TriMesh:
+    used = np.zeros(len(xy), bool)
+    used[tri.ravel()] = True
+    new = np.cumsum(used) - 1
+    return TriMesh(xy[used], new[tri], new[bedges] if len(bedges) else bedges, btags)
+
+
+def read_msh(path: str) -> TriMesh:
+    """Read a gmsh .msh file: triangles, plus line elements tagged by their physical-group names.
+
+    Boundary lines without a named physical group are tagged 'outer'.
+    """
+    import meshio
+
+    m = meshio.read(path)
+    tri = np.concatenate([c.data for c in m.cells if c.type == "triangle"]) if any(
+        c.type == "triangle" for c in m.cells) else None
+    if tri is None:
+        raise ValueError(f"{path}: no triangle cells")
+    names = {int(v[0]): k for k, v in m.field_data.items() if len(v) > 1 and int(v[1]) == 1}
+    phys = m.cell_data.get("gmsh:physical")
+    bedges, btags = [], []
+    for i, c in enumerate(m.cells):
+        if c.type == "line":
+            ids = phys[i] if phys is not None else np.zeros(len(c.data), int)
+            bedges.append(c.data)
+            btags.extend(names.get(int(t), "outer") for t in ids)
+    be = np.concatenate(bedges) if bedges else np.zeros((0, 2), np.int64)
+    return _compact(m.points[:, :2], tri, be, btags)

@@ -1,0 +1,213 @@
+"""Build the rock Model from a Scenario: mesh → blocks, springs, boundary data, stable Δt."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import warp as wp
+
+from .._warp import init_warp
+from ..geometry.mesh import TriMesh, generate_mesh
+from ..materials.elastic import lame
+from ..materials.interface import softening_slope
+from ..scenario.schema import Scenario
+from .model import Model
+from .topology import Topology, build_topology
+
+
+class ModelBuilder:
+    """Host-side assembly of the rock model; ``finalize(device)`` moves it to a Warp device."""
+
+    def __init__(self, scenario: Scenario, mesh: TriMesh | None = None):
+        self.scenario = scenario
+        self.mesh = mesh if mesh is not None else generate_mesh(scenario.geometry, scenario.simulation.seed)
+        self.topology = build_topology(self.mesh)
+        self._assemble()
+
+    # ------------------------------------------------------------------ host assembly
+    def _assemble(self) -> None:
+        sc, mesh, topo = self.scenario, self.mesh, self.topology
+        rock = sc.rock
+        tri = mesh.triangles
+        X = mesh.vertices[tri].reshape(-1, 2)
+        area = 0.5 * _cross(X[1::3] - X[0::3], X[2::3] - X[0::3])
+        self.lam, self.mu = lame(rock.youngs_modulus, rock.poisson_ratio)
+        h = {}
+        h["node_X"] = X
+        h["node_mass"] = np.repeat(rock.density * area / 3.0, 3)
+        h["elem_area0"] = area
+
+        # springs
+        s1 = topo.iface_slots[:, 0]
+        na, nb = s1, 3 * (s1 // 3) + (s1 % 3 + 1) % 3
+        L = np.linalg.norm(X[nb] - X[na], axis=1)
+        e1, e2 = topo.iface_elems[:, 0], topo.iface_elems[:, 1]
+        if rock.stiffness_mode == "per_area":
+            kn_a = np.full(len(L), rock.kn)
+            ks_a = np.full(len(L), rock.ks)
+        else:
+            hbar = (area[e1] + area[e2]) / L          # mean of the two heights 2A/L
+            kn_a = rock.spring_penalty * rock.plane_strain_modulus / hbar
+            ks_a = kn_a.copy()
+        ac = L / 2.0
+        h["pair_ac"] = np.repeat(ac, 2)
+        h["pair_l0"] = np.repeat(L, 2)
+        h["pair_kn_area"] = np.repeat(kn_a, 2)
+        h["pair_kn"] = np.repeat(kn_a * ac, 2)
+        h["pair_ks"] = np.repeat(ks_a * ac, 2)
+        h["pair_t0"] = np.full(2 * len(L), rock.tensile_strength)
+        h["pair_c0"] = np.full(2 * len(L), rock.cohesion)
+        kmin = float(kn_a.min()) if len(kn_a) else 1.0
+        self.slope_t = softening_slope(rock.tensile_strength, rock.tensile_fracture_energy, kmin)
+        self.slope_c = softening_slope(rock.cohesion, rock.shear_fracture_energy, float(ks_a.min()) if len(ks_a) else 1.0)
+        # the unit normal of each interface, e1 → e2, for the stable-step row sums
+        t = (X[nb] - X[na]) / L[:, None]
+        h["iface_normal"] = np.stack([t[:, 1], -t[:, 0]], 1)
+
+        self._boundary_data(h, X)
+        self.host = h
+        self.stable_dt = self._gershgorin_dt(h, X)
+
+    def _boundary_data(self, h: dict, X: np.ndarray) -> None:
+        sc, topo = self.scenario, self.topology
+        rock = sc.rock
+        n_node = len(X)
+        P = np.tile(np.eye(2), (n_node, 1, 1))
+        C = np.zeros((n_node, 2, 2))
+        constrained = np.zeros(n_node, bool)
+        self.pulses = []
+        pulse_of_side: dict[str, int] = {}
+        for side, cfg in sc.boundaries.items():
+            if cfg.type == "pressure":
+                pulse_of_side[side] = len(self.pulses)
+                self.pulses.append(cfg.pulse)
+        for bp in sc.borehole_pressure:
+            pulse_of_side[f"hole{bp.borehole}"] = len(self.pulses)
+            self.pulses.append(bp.pulse)
+        sig0 = np.array([[sc.insitu.sxx, sc.insitu.sxy], [sc.insitu.sxy, sc.insitu.syy]])
+        ln0, ln1, lp, lf = [], [], [], []
+        rho_cp = rock.density * rock.p_wave_speed
+        rho_cs = rock.density * rock.s_wave_speed
+        for slot, tag in zip(topo.boundary_slots, topo.boundary_slot_tags):
+            n0 = int(slot)
+            n1 = int(3 * (slot // 3) + (slot % 3 + 1) % 3)
+            d = X[n1] - X[n0]
+            L = float(np.hypot(*d))
+            n = np.array([d[1], -d[0]]) / L            # outward normal of the block
+            tvec = d / L
+            kind = sc.boundary(tag).type
+            for node in (n0, n1):
+                if kind == "fixed":
+                    P[node] = 0.0
+                    constrained[node] = True
+                elif kind == "roller":
+                    P[node] = P[node] @ (np.eye(2) - np.outer(n, n))
+                    constrained[node] = True
+                elif kind == "viscous":
+                    C[node] += 0.5 * L * (rho_cp * np.outer(n, n) + rho_cs * np.outer(tvec, tvec))
+                    constrained[node] = True
+            f0 = np.zeros(2)
+            if sc.insitu.active and not tag.startswith("hole") and kind in ("free", "viscous", "pressure"):
+                f0 = 0.5 * L * (sig0 @ n)                 # consistent traction σ⁰·n on each of the two nodes
+            pid = pulse_of_side.get(tag, -1)
+            if pid >= 0 or np.any(f0 != 0.0):
+                ln0.append(n0), ln1.append(n1), lp.append(pid), lf.append(f0)
+        idx = np.full(n_node, -1, np.int64)
+        cn = np.flatnonzero(constrained)
+        idx[cn] = np.arange(len(cn))
+        h["node_bc"] = idx
+        h["bc_P"] = P[cn] if len(cn) else np.zeros((1, 2, 2))
+        h["bc_C"] = C[cn] if len(cn) else np.zeros((1, 2, 2))
+        h["ledge_n0"] = np.array(ln0, np.int64)
+        h["ledge_n1"] = np.array(ln1, np.int64)
+        h["ledge_pulse"] = np.array(lp, np.int64)
+        h["ledge_f0"] = np.array(lf).reshape(-1, 2)
+
+    def _gershgorin_dt(self, h: dict, X: np.ndarray) -> float:
+        """2/ω_max with ω_max² ≤ max_i R_i/m_i, R_i the absolute row sums of the stiffness (METHOD §1.7)."""
+        row = element_row_sums(X, self.lam, self.mu)              # [N, 2]
+        pn = self.topology.pair_nodes
+        nrm = np.repeat(h["iface_normal"], 2, axis=0)
+        kn, ks = h["pair_kn"], h["pair_ks"]
+        nx, ny = nrm[:, 0], nrm[:, 1]
+        cross = np.abs(kn - ks) * np.abs(nx * ny)
+        rx = 2.0 * (kn * nx**2 + ks * ny**2 + cross)
+        ry = 2.0 * (kn * ny**2 + ks * nx**2 + cross)
+        if not self.scenario.rock.unbreakable:
+            # allowance for one node-to-edge block contact of the same stiffness (METHOD §1.5)
+            rx, ry = 2.0 * rx, 2.0 * ry
+        for col in (0, 1):
+            np.add.at(row[:, 0], pn[:, col], rx)
+            np.add.at(row[:, 1], pn[:, col], ry)
+        omega2 = np.max(row / h["node_mass"][:, None])
+        return 2.0 / math.sqrt(omega2)
+
+    # ------------------------------------------------------------------ device
+    def finalize(self, device: str = "cpu") -> Model:
+        init_warp()
+        h, rock = self.host, self.scenario.rock
+        d = device
+
+        def arr(a, dtype):
+            return wp.array(np.ascontiguousarray(a), dtype=dtype, device=d)
+
+        pair_slope = np.zeros((self.topology.pair_nodes.shape[0], 2))
+        pair_slope[:, 0], pair_slope[:, 1] = self.slope_t, self.slope_c
+        m = Model(
+            mesh=self.mesh, topology=self.topology, device=d,
+            lam=self.lam, mu=self.mu, density=rock.density,
+            tan_phi=math.tan(math.radians(rock.friction_angle)),
+            tan_phi_r=math.tan(math.radians(rock.residual_friction)),
+            slope_t=self.slope_t, slope_c=self.slope_c,
+            breakable=0 if rock.unbreakable else 1,
+            node_mass=arr(h["node_mass"], wp.float64),
+            node_X=arr(h["node_X"], wp.vec2d),
+            node_pairs=arr(self.topology.node_pairs.astype(np.int32), wp.vec2i),
+            node_pair_sign=arr(self.topology.node_pair_sign.astype(np.float64), wp.vec2d),
+            node_bc=arr(h["node_bc"].astype(np.int32), wp.int32),
+            bc_P=arr(h["bc_P"], wp.mat22d),
+            bc_C=arr(h["bc_C"], wp.mat22d),
+            elem_area0=arr(h["elem_area0"], wp.float64),
+            pair_i=arr(self.topology.pair_nodes[:, 0].astype(np.int32), wp.int32),
+            pair_j=arr(self.topology.pair_nodes[:, 1].astype(np.int32), wp.int32),
+            pair_kn=arr(h["pair_kn"], wp.float64),
+            pair_ks=arr(h["pair_ks"], wp.float64),
+            pair_ac=arr(h["pair_ac"], wp.float64),
+            pair_l0=arr(h["pair_l0"], wp.float64),
+            pair_t0=arr(h["pair_t0"], wp.float64),
+            pair_c0=arr(h["pair_c0"], wp.float64),
+            ledge_n0=arr(h["ledge_n0"].astype(np.int32), wp.int32),
+            ledge_n1=arr(h["ledge_n1"].astype(np.int32), wp.int32),
+            ledge_pulse=arr(h["ledge_pulse"].astype(np.int32), wp.int32),
+            ledge_f0=arr(h["ledge_f0"], wp.vec2d),
+            pulses=list(self.pulses),
+            stable_dt=self.stable_dt,
+            host=h,
+        )
+        return m
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+
+
+def cst_stiffness(X: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """Plane-strain CST stiffness matrices A·BᵀDB, shape [E, 6, 6] (dofs x0,y0,x1,y1,x2,y2)."""
+    p0, p1, p2 = X[0::3], X[1::3], X[2::3]
+    area = 0.5 * _cross(p1 - p0, p2 - p0)
+    b = np.stack([p1[:, 1] - p2[:, 1], p2[:, 1] - p0[:, 1], p0[:, 1] - p1[:, 1]], 1) / (2 * area[:, None])
+    c = np.stack([p2[:, 0] - p1[:, 0], p0[:, 0] - p2[:, 0], p1[:, 0] - p0[:, 0]], 1) / (2 * area[:, None])
+    B = np.zeros((len(area), 3, 6))
+    B[:, 0, 0::2] = b
+    B[:, 1, 1::2] = c
+    B[:, 2, 0::2] = c
+    B[:, 2, 1::2] = b
+    D = np.array([[lam + 2 * mu, lam, 0], [lam, lam + 2 * mu, 0], [0, 0, mu]])
+    return area[:, None, None] * np.einsum("eki,kl,elj->eij", B, D, B)
+
+
+def element_row_sums(X: np.ndarray, lam: float, mu: float) -> np.ndarray:
+    """Absolute row sums of the CST stiffness per node and direction, shape [N, 2]."""
+    K = cst_stiffness(X, lam, mu)
+    return np.abs(K).sum(axis=2).reshape(-1, 2)

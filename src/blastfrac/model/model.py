@@ -1,0 +1,158 @@
+"""Model (static arrays) and State (time-varying arrays) of the rock block system.
+
+Shapes use E elements, N = 3E nodes, Q interfaces, P = 2Q springs (node pairs),
+L loaded boundary edges, C constrained/damped nodes. Units SI, forces per unit thickness.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import warp as wp
+
+from ..geometry.mesh import TriMesh
+from .topology import Topology
+
+
+@dataclass
+class Model:
+    """Static description of the rock on one device.
+
+    node_mass: lumped mass ρA/3 [kg/m], [N]
+    node_X: reference (initial) position [m], [N] vec2d
+    node_pairs, node_pair_sign: the springs of each node and its side (+1 j, −1 i), [N] vec2i
+    node_bc: index into the bc_* arrays or −1, [N] int32
+    bc_P: velocity projection of a constrained node (0 fixed, I−nnᵀ roller, I free), [C] mat22d
+    bc_C: dashpot matrix of a viscous node [N·s/m per m], [C] mat22d
+    elem_area0: initial element area [m²], [E]
+    pair_i, pair_j: node indices, [P] int32
+    pair_kn, pair_ks: spring stiffness K = k·Ac [N/m per m], [P]
+    pair_ac: tributary area Ac (edge length/2, unit thickness) [m], [P]
+    pair_l0: length of the edge the spring belongs to [m], [P]
+    pair_t0, pair_c0: initial tensile strength and cohesion [Pa], [P]
+    ledge_n0, ledge_n1: nodes of loaded boundary edges (n0→n1 runs counter-clockwise around the element), [L]
+    ledge_pulse: pulse index or −1, [L]; ledge_f0: constant force on each of its nodes [N/m], [L] vec2d
+    """
+
+    mesh: TriMesh
+    topology: Topology
+    device: str
+    lam: float
+    mu: float
+    density: float
+    tan_phi: float
+    tan_phi_r: float
+    slope_t: float
+    slope_c: float
+    breakable: int
+    node_mass: wp.array
+    node_X: wp.array
+    node_pairs: wp.array
+    node_pair_sign: wp.array
+    node_bc: wp.array
+    bc_P: wp.array
+    bc_C: wp.array
+    elem_area0: wp.array
+    pair_i: wp.array
+    pair_j: wp.array
+    pair_kn: wp.array
+    pair_ks: wp.array
+    pair_ac: wp.array
+    pair_l0: wp.array
+    pair_t0: wp.array
+    pair_c0: wp.array
+    ledge_n0: wp.array
+    ledge_n1: wp.array
+    ledge_pulse: wp.array
+    ledge_f0: wp.array
+    pulses: list = field(default_factory=list)
+    stable_dt: float = 0.0
+    host: dict = field(default_factory=dict)
+
+    @property
+    def element_count(self) -> int:
+        return self.mesh.element_count
+
+    @property
+    def node_count(self) -> int:
+        return 3 * self.mesh.element_count
+
+    @property
+    def interface_count(self) -> int:
+        return len(self.topology.iface_elems)
+
+    @property
+    def spring_count(self) -> int:
+        return 2 * self.interface_count
+
+    @property
+    def loaded_edge_count(self) -> int:
+        return self.ledge_n0.shape[0]
+
+    def state(self) -> "State":
+        """A fresh State at rest in the reference configuration."""
+        d = self.device
+        n, e, p = self.node_count, self.element_count, self.spring_count
+        st = State(
+            x=wp.clone(self.node_X),
+            v=wp.zeros(n, dtype=wp.vec2d, device=d),
+            f=wp.zeros(n, dtype=wp.vec2d, device=d),
+            sigma=wp.zeros(e, dtype=wp.vec3d, device=d),
+            pair_F=wp.zeros(p, dtype=wp.vec2d, device=d),
+            pair_force=wp.zeros(p, dtype=wp.vec2d, device=d),
+            pair_str=wp.array(np.stack([self.host["pair_t0"], self.host["pair_c0"]], 1), dtype=wp.vec2d, device=d),
+            pair_mode=wp.zeros(p, dtype=wp.int32, device=d),
+            pair_dropped=wp.zeros(p, dtype=wp.int32, device=d),
+            pair_g0=wp.zeros(p, dtype=wp.float64, device=d),
+            pair_tbreak=wp.full(p, -1.0, dtype=wp.float64, device=d),
+            pair_work=wp.zeros(p, dtype=wp.float64, device=d),
+            pair_efrac=wp.zeros(p, dtype=wp.float64, device=d),
+            ledge_fprev=wp.zeros(2 * self.loaded_edge_count, dtype=wp.vec2d, device=d),
+            pulse_values=wp.zeros(max(1, len(self.pulses)), dtype=wp.float64, device=d),
+            energy_acc=wp.zeros(4, dtype=wp.float64, device=d),
+        )
+        return st
+
+
+# energy_acc slots
+EXTERNAL_WORK = 0
+VISCOUS_ABSORBED = 1
+DAMPING_DISSIPATED = 2
+CONTACT_DISSIPATED = 3
+
+
+@dataclass
+class State:
+    """Time-varying arrays of the rock.
+
+    x: current node position [m], v: node velocity at the last half step [m/s], f: node force [N/m]
+    sigma: element Cauchy stress (σxx, σyy, σxy) [Pa]
+    pair_F: spring (Fn, Fs) in the local frame [N/m], Fn > 0 compression
+    pair_force: force of the spring on its j node in global axes [N/m]
+    pair_str: current (T, c) strengths [Pa] (soften when fracture energies are given)
+    pair_mode: 0 intact, 1 broken in tension, 2 broken in shear; pair_dropped: 1 once fully separated
+    pair_g0: gap at which the broken spring carries no normal force [m]
+    pair_tbreak: time of failure [s] (−1 while intact)
+    pair_work: work done on the spring so far [J/m]; pair_efrac: energy dissipated by its failure [J/m]
+    ledge_fprev: force applied to each loaded-edge node in the previous step (for exact external work)
+    pulse_values: current value of each pressure pulse [Pa]
+    energy_acc: accumulated external work, viscous-boundary absorption, damping and contact losses [J/m]
+    """
+
+    x: wp.array
+    v: wp.array
+    f: wp.array
+    sigma: wp.array
+    pair_F: wp.array
+    pair_force: wp.array
+    pair_str: wp.array
+    pair_mode: wp.array
+    pair_dropped: wp.array
+    pair_g0: wp.array
+    pair_tbreak: wp.array
+    pair_work: wp.array
+    pair_efrac: wp.array
+    ledge_fprev: wp.array
+    pulse_values: wp.array
+    energy_acc: wp.array

@@ -1,0 +1,71 @@
+"""Detonation-products state update (METHOD §2.3, §2.5, §2.6): q, JWL energy/pressure, c, stress."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq
+
+F64 = wp.float64
+
+
+@wp.func
+def bulk_viscosity(trD: wp.float64, rho: wp.float64, l: wp.float64, c: wp.float64, q1: wp.float64, q2: wp.float64):
+    """Artificial bulk viscosity q [Pa] (compression only): Q1 rho l^2 trD^2 - Q2 rho l c trD."""
+    if trD >= F64(0.0):
+        return F64(0.0)
+    return q1 * rho * l * l * trD * trD - q2 * rho * l * c * trD
+
+
+@wp.kernel
+def update_jwl_state(
+    active: wp.array(dtype=wp.int32),
+    vol0: wp.array(dtype=wp.float64),
+    vol: wp.array(dtype=wp.float64),
+    vol_prev: wp.array(dtype=wp.float64),
+    rho: wp.array(dtype=wp.float64),
+    grad_v: wp.array(dtype=wp.mat22d),
+    burn: wp.array(dtype=wp.float64),
+    rho0: wp.float64,
+    D: wp.float64,
+    A: wp.float64,
+    B: wp.float64,
+    R1: wp.float64,
+    R2: wp.float64,
+    w: wp.float64,
+    q1: wp.float64,
+    q2: wp.float64,
+    v_max: wp.float64,
+    ie: wp.array(dtype=wp.float64),
+    pres: wp.array(dtype=wp.float64),
+    q: wp.array(dtype=wp.float64),
+    cs: wp.array(dtype=wp.float64),
+    stress: wp.array(dtype=wp.mat22d),
+):
+    """Advance q, p [Pa], ie [J/m], c [m/s] and sigma = -(p + q) I of each products particle."""
+    p = wp.tid()
+    if active[p] == 0:
+        return
+    v0 = vol0[p]
+    V = vol[p] / v0
+    L = grad_v[p]
+    trD = L[0, 0] + L[1, 1]
+    l = wp.sqrt(vol[p])
+    qn = bulk_viscosity(trD, rho[p], l, cs[p], q1, q2)
+    F = burn[p]
+    if V > v_max:
+        F = F64(0.0)
+    r = jwl_energy_update(V, vol[p], vol_prev[p], v0, ie[p], pres[p], qn, F, A, B, R1, R2, w)
+    pn = r[0]
+    ie[p] = r[1]
+    pres[p] = pn
+    q[p] = qn
+    Vc = wp.max(V, F64(0.2))
+    c2 = jwl_sound_speed_sq(Vc, r[1] / v0, pn, rho0, A, B, R1, R2, w)
+    c2 = wp.max(c2, D * D * (F64(1.0) - burn[p]) * (F64(1.0) - burn[p]))
+    c = wp.sqrt(c2)
+    if trD < F64(0.0):
+        s = q2 * c - q1 * l * trD
+        c = s + wp.sqrt(s * s + c * c)
+    cs[p] = c
+    stress[p] = wp.mat22d(-(pn + qn), F64(0.0), F64(0.0), -(pn + qn))

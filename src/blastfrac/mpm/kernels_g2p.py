@@ -1,0 +1,114 @@
+"""Grid-to-particle transfers (METHOD §2.2 steps 4 and 6): gathers, one kernel per operation."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from blastfrac.mpm.kernels_p2g import particle_stencil
+from blastfrac.mpm.shape import wrap_index
+
+F64 = wp.float64
+
+
+@wp.kernel
+def g2p_velocity(
+    x: wp.array(dtype=wp.vec2d),
+    active: wp.array(dtype=wp.int32),
+    g_vel: wp.array(dtype=wp.vec2d),
+    g_dvel: wp.array(dtype=wp.vec2d),
+    x0: wp.float64,
+    y0: wp.float64,
+    inv_h: wp.float64,
+    nx: int,
+    ny: int,
+    px: int,
+    py: int,
+    kind: int,
+    l: wp.float64,
+    flip: wp.float64,
+    v: wp.array(dtype=wp.vec2d),
+    v_pic: wp.array(dtype=wp.vec2d),
+):
+    """v_p = flip (v_p + sum N dv_I) + (1 - flip) sum N v_I; v_pic = sum N v_I moves the particle [m/s]."""
+    p = wp.tid()
+    if active[p] == 0:
+        return
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    vp = wp.vec2d()
+    dv = wp.vec2d()
+    for i in range(3):
+        ii = wrap_index(bx + i, nx, px)
+        for j in range(3):
+            n = wrap_index(by + j, ny, py) * nx + ii
+            N = wx[i] * wy[j]
+            vp += N * g_vel[n]
+            dv += N * g_dvel[n]
+    v[p] = flip * (v[p] + dv) + (F64(1.0) - flip) * vp
+    v_pic[p] = vp
+
+
+@wp.kernel
+def update_particle_kinematics(
+    active: wp.array(dtype=wp.int32),
+    mass: wp.array(dtype=wp.float64),
+    g_vel: wp.array(dtype=wp.vec2d),
+    v_pic: wp.array(dtype=wp.vec2d),
+    x0: wp.float64,
+    y0: wp.float64,
+    inv_h: wp.float64,
+    nx: int,
+    ny: int,
+    px: int,
+    py: int,
+    kind: int,
+    l: wp.float64,
+    dt: wp.float64,
+    x: wp.array(dtype=wp.vec2d),
+    vol: wp.array(dtype=wp.float64),
+    vol_prev: wp.array(dtype=wp.float64),
+    rho: wp.array(dtype=wp.float64),
+    grad_v: wp.array(dtype=wp.mat22d),
+    deactivated: wp.array(dtype=wp.int32),
+):
+    """L_p = sum v_I (x) grad N_I (remapped v_I); V_p *= det(I + dt L); rho = m/V; x_p += dt v_pic.
+
+    A particle whose stencil leaves a non-periodic grid is deactivated (active = 0) and counted.
+    """
+    p = wp.tid()
+    if active[p] == 0:
+        return
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    L = wp.mat22d()
+    for i in range(3):
+        ii = wrap_index(bx + i, nx, px)
+        for j in range(3):
+            n = wrap_index(by + j, ny, py) * nx + ii
+            grad = wp.vec2d(dwx[i] * wy[j] * inv_h, wx[i] * dwy[j] * inv_h)
+            L += wp.outer(g_vel[n], grad)
+    grad_v[p] = L
+    J = wp.determinant(wp.identity(n=2, dtype=wp.float64) + dt * L)
+    vol_prev[p] = vol[p]
+    vol[p] = vol[p] * J
+    rho[p] = mass[p] / vol[p]
+    xn = x[p] + dt * v_pic[p]
+    fx = (xn[0] - x0) * inv_h
+    fy = (xn[1] - y0) * inv_h
+    if px != 0:
+        fx = fx - wp.floor(fx / wp.float64(nx)) * wp.float64(nx)
+        xn[0] = x0 + fx / inv_h
+    if py != 0:
+        fy = fy - wp.floor(fy / wp.float64(ny)) * wp.float64(ny)
+        xn[1] = y0 + fy / inv_h
+    x[p] = xn
+    out = 0
+    if px == 0:
+        b = int(wp.floor(fx - F64(0.5)))
+        if b < 0 or b + 2 > nx - 1:
+            out = 1
+    if py == 0:
+        b = int(wp.floor(fy - F64(0.5)))
+        if b < 0 or b + 2 > ny - 1:
+            out = 1
+    if out != 0 or J <= F64(0.0):
+        active[p] = 0
+        wp.atomic_add(deactivated, 0, 1)

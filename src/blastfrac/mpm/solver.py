@@ -1,0 +1,398 @@
+"""MPMSolver: explicit MUSL material point method for detonation products (METHOD §2).
+
+One step (``step``) is four stages that a coupled simulation may interleave:
+
+1. ``to_grid(dt)``       P2G: node mass, momentum, internal force -V sigma grad N and the
+                          external particle forces ``f_ext_p`` (N per unit thickness);
+2. ``update_grid(dt)``   mass cut-off, p_I += dt f_I, boundary conditions;
+3. ``to_particles(dt)``  G2P FLIP/PIC blend, MUSL remap of momentum, velocity gradient,
+                          volume/density update, particle motion (particles leaving the grid
+                          are deactivated);
+4. ``update_eos(dt, t)`` burn fraction at t + dt, artificial viscosity, JWL energy/pressure,
+                          sound speed, stress (or the linear-elastic update for solid tests).
+
+All arrays are allocated once in the constructor; a step allocates nothing.  2D plane
+strain: masses [kg/m], volumes [m^2/m = m^2], energies [J/m], forces [N/m].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from blastfrac._warp import resolve_device
+from blastfrac.materials.cj import cj_state
+from blastfrac.materials.jwl import JWLParams, jwl_sound_speed_sq_np
+from blastfrac.materials.linear_elastic_mp import LinearElasticMP, strain_energy_density_np, update_elastic_state
+from blastfrac.mpm.burn import BURN_MODES, lighting_times
+from blastfrac.mpm.grid import Grid, GridSpec
+from blastfrac.mpm.kernels_burn import update_burn
+from blastfrac.mpm.kernels_eos import update_jwl_state
+from blastfrac.mpm.kernels_g2p import g2p_velocity, update_particle_kinematics
+from blastfrac.mpm.kernels_grid import update_grid_momentum, velocity_from_momentum
+from blastfrac.mpm.kernels_misc import max_signal_speed
+from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
+from blastfrac.mpm.seeding import charge_area_centroid, charge_bbox, seed_charges
+from blastfrac.mpm.shape import SHAPE_IDS, shape_1d_np
+
+F64 = np.float64
+
+
+@dataclass(frozen=True)
+class MPMOptions:
+    """Numerical options (see ExplosiveConfig for meanings and units)."""
+
+    shape: str = "bspline2"
+    ppc: int = 2
+    flip: float = 0.99
+    cfl: float = 0.2
+    q1: float = 1.5
+    q2: float = 0.06
+    mass_cutoff: float = 1e-5
+    v_max: float = 100.0
+    burn_mode: str = "combined"
+    burn_width: float = 1.5
+    p_cj: float | None = None
+
+
+def grid_from_config(config) -> GridSpec:
+    """Grid covering ``grid.bounds`` or the charges' box plus margin (+2 stencil cells)."""
+    g = config.grid
+    if g.bounds is not None:
+        lo, hi = np.asarray(g.bounds[0], float), np.asarray(g.bounds[1], float)
+    else:
+        boxes = [charge_bbox(c) for c in config.charges]
+        lo = np.min([b[0] for b in boxes], axis=0)
+        hi = np.max([b[1] for b in boxes], axis=0)
+        margin = g.margin if g.margin is not None else float(np.max(hi - lo))
+        lo, hi = lo - margin, hi + margin
+    return GridSpec.from_bounds(lo, hi, g.cell_size)
+
+
+class MPMSolver:
+    """Explicit MUSL MPM for JWL detonation products (or a linear-elastic solid, for tests).
+
+    Particle arrays (shape [n]): x, v, v_pic [m/s], f_ext_p [N/m] (vec2d); mass [kg/m];
+    vol, vol0, vol_prev [m^2]; rho [kg/m^3]; ie [J/m]; p, q [Pa]; burn [-];
+    light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32).
+    Grid arrays: ``self.grid`` (:class:`Grid`).
+    """
+
+    # ------------------------------------------------------------------ construction
+    def __init__(self, config, device: str = "cpu"):
+        params: JWLParams = config.jwl()
+        opts = MPMOptions(
+            shape=config.shape,
+            ppc=config.grid.points_per_cell,
+            flip=config.flip,
+            cfl=config.cfl,
+            q1=config.q1,
+            q2=config.q2,
+            mass_cutoff=config.mass_cutoff,
+            v_max=config.v_max,
+            burn_mode=config.burn.mode,
+            burn_width=config.burn.width_factor,
+            p_cj=config.burn.p_cj,
+        )
+        spec = grid_from_config(config)
+        x, vol, _ = seed_charges(config.charges, spec, opts.ppc)
+        if config.detonation_points:
+            pts = np.array([d.position for d in config.detonation_points], float)
+            delays = np.array([d.delay for d in config.detonation_points], float)
+        else:
+            pts = np.array([charge_area_centroid(c)[1] for c in config.charges])
+            delays = np.zeros(len(pts))
+        t_l = lighting_times(x, pts, delays, params.D)
+        self.config = config
+        self._build(x, vol, spec, params, opts, device, light_time=t_l)
+
+    @classmethod
+    def from_arrays(
+        cls,
+        x: np.ndarray,
+        vol: np.ndarray,
+        grid: GridSpec,
+        material: JWLParams | LinearElasticMP,
+        options: MPMOptions | None = None,
+        device: str = "cpu",
+        v: np.ndarray | None = None,
+        light_time: np.ndarray | None = None,
+        burn: np.ndarray | None = None,
+    ) -> MPMSolver:
+        """Build from host arrays: x [n,2] m, vol [n] m^2, optional v [n,2] m/s, light_time [n] s, burn [n]."""
+        self = cls.__new__(cls)
+        self.config = None
+        self._build(x, vol, grid, material, options or MPMOptions(), device, v=v, light_time=light_time, burn=burn)
+        return self
+
+    def _build(self, x, vol, spec: GridSpec, material, opts: MPMOptions, device, v=None, light_time=None, burn=None):
+        self.device = resolve_device(device)
+        self.spec, self.material, self.opts = spec, material, opts
+        self.is_jwl = isinstance(material, JWLParams)
+        x = np.ascontiguousarray(x, dtype=F64).reshape(-1, 2)
+        vol = np.ascontiguousarray(vol, dtype=F64).reshape(-1)
+        n = len(x)
+        self.n = n
+        rho0 = material.rho0
+        self.shape_kind = SHAPE_IDS[opts.shape]
+        self.shape_l = 0.5 / opts.ppc  # uGIMP l_p / h
+        self.m_cut = opts.mass_cutoff * rho0 * spec.h**2
+        d = self.device
+
+        def z(dtype):
+            return wp.zeros(n, dtype=dtype, device=d)
+
+        self.x = wp.array(x, dtype=wp.vec2d, device=d)
+        self.v = wp.array(np.zeros((n, 2)) if v is None else np.asarray(v, F64), dtype=wp.vec2d, device=d)
+        self.v_pic, self.f_ext_p = z(wp.vec2d), z(wp.vec2d)
+        self.mass = wp.array(rho0 * vol, dtype=wp.float64, device=d)
+        self.vol = wp.array(vol, dtype=wp.float64, device=d)
+        self.vol0 = wp.array(vol, dtype=wp.float64, device=d)
+        self.vol_prev = wp.array(vol, dtype=wp.float64, device=d)
+        self.rho = wp.array(np.full(n, rho0), dtype=wp.float64, device=d)
+        self.ie, self.p, self.q, self.cs = z(wp.float64), z(wp.float64), z(wp.float64), z(wp.float64)
+        self.burn = wp.array(np.zeros(n) if burn is None else np.asarray(burn, F64), dtype=wp.float64, device=d)
+        lt = np.zeros(n) if light_time is None else np.asarray(light_time, F64)
+        self.light_time = wp.array(lt, dtype=wp.float64, device=d)
+        self.stress, self.grad_v = z(wp.mat22d), z(wp.mat22d)
+        self.active = wp.array(np.ones(n, dtype=np.int32), dtype=wp.int32, device=d)
+        self.grid = Grid(spec, d)
+        self._deactivated = wp.zeros(1, dtype=wp.int32, device=d)
+        self._smax = wp.zeros(1, dtype=wp.float64, device=d)
+        if self.is_jwl:
+            P = material
+            self.p_cj = opts.p_cj if opts.p_cj is not None else cj_state(P).p
+            self.burn_mode = BURN_MODES[opts.burn_mode]
+            self.ie.assign(P.E0 * vol)
+            c0 = np.sqrt(jwl_sound_speed_sq_np(1.0, P.E0, 0.0, P.rho0, P.A, P.B, P.R1, P.R2, P.omega))
+            self.cs.assign(np.full(n, max(float(c0), P.D)))
+            self._chem0 = P.E0 * vol
+        else:
+            self.cs.assign(np.full(n, material.p_wave_speed))
+        self._check_in_grid(x)
+        self._geo = (
+            float(spec.x0),
+            float(spec.y0),
+            1.0 / spec.h,
+            spec.nx,
+            spec.ny,
+            int(spec.periodic_x),
+            int(spec.periodic_y),
+            self.shape_kind,
+            self.shape_l,
+        )
+
+    def _check_in_grid(self, x: np.ndarray) -> None:
+        s = self.spec
+        ok = np.ones(len(x), dtype=bool)
+        for ax, (o, nn, per) in enumerate(((s.x0, s.nx, s.periodic_x), (s.y0, s.ny, s.periodic_y))):
+            if not per:
+                b = np.floor((x[:, ax] - o) / s.h - 0.5)
+                ok &= (b >= 0) & (b + 2 <= nn - 1)
+        if not ok.all():
+            act = self.active.numpy().copy()
+            act[~ok] = 0
+            self.active.assign(act)
+            self._deactivated.assign(np.array([int((~ok).sum())], dtype=np.int32))
+
+    # ------------------------------------------------------------------ the four stages
+    def to_grid(self, dt: float) -> None:
+        """P2G (mass, momentum, forces incl. f_ext_p) at the current positions."""
+        g = self.grid
+        g.mass.zero_()
+        g.mom.zero_()
+        g.force.zero_()
+        wp.launch(
+            p2g,
+            dim=self.n,
+            inputs=[self.x, self.v, self.mass, self.vol, self.stress, self.f_ext_p, self.active, *self._geo_f()],
+            outputs=[g.mass, g.mom, g.force],
+            device=self.device,
+        )
+
+    def update_grid(self, dt: float) -> None:
+        """Integrate node momenta over dt [s] with the mass cut-off and boundary conditions."""
+        g = self.grid
+        wp.launch(
+            update_grid_momentum,
+            dim=self.spec.node_count,
+            inputs=[g.mass, g.bc_mask, g.bc_vel, g.force, F64(dt), F64(self.m_cut)],
+            outputs=[g.mom, g.vel, g.dvel],
+            device=self.device,
+        )
+
+    def to_particles(self, dt: float) -> None:
+        """G2P (FLIP/PIC), MUSL remap, velocity gradient, volume and position update."""
+        g, geo, d = self.grid, self._geo_f(), self.device
+        wp.launch(
+            g2p_velocity,
+            dim=self.n,
+            inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip)],
+            outputs=[self.v, self.v_pic],
+            device=d,
+        )
+        g.mom.zero_()
+        wp.launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.mass, self.active, *geo], outputs=[g.mom], device=d)
+        wp.launch(
+            velocity_from_momentum,
+            dim=self.spec.node_count,
+            inputs=[g.mass, g.bc_mask, g.bc_vel, g.mom, F64(self.m_cut)],
+            outputs=[g.vel],
+            device=d,
+        )
+        wp.launch(
+            update_particle_kinematics,
+            dim=self.n,
+            inputs=[self.active, self.mass, g.vel, self.v_pic, *geo, F64(dt)],
+            outputs=[self.x, self.vol, self.vol_prev, self.rho, self.grad_v, self._deactivated],
+            device=d,
+        )
+
+    def update_eos(self, dt: float, t: float) -> None:
+        """Burn fraction at t + dt, then the material update (JWL products or elastic solid)."""
+        d = self.device
+        if not self.is_jwl:
+            m = self.material
+            wp.launch(
+                update_elastic_state,
+                dim=self.n,
+                inputs=[self.active, self.grad_v, self.rho, F64(dt), F64(m.lam), F64(m.mu)],
+                outputs=[self.stress, self.p, self.cs],
+                device=d,
+            )
+            return
+        P, o = self.material, self.opts
+        wp.launch(
+            update_burn,
+            dim=self.n,
+            inputs=[self.active, self.light_time, self.vol, self.vol0, F64(t + dt), F64(P.D), F64(P.rho0), F64(self.p_cj),
+                    F64(o.burn_width), self.burn_mode],
+            outputs=[self.burn],
+            device=d,
+        )
+        wp.launch(
+            update_jwl_state,
+            dim=self.n,
+            inputs=[self.active, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v, self.burn, F64(P.rho0), F64(P.D),
+                    F64(P.A), F64(P.B), F64(P.R1), F64(P.R2), F64(P.omega), F64(o.q1), F64(o.q2), F64(o.v_max)],
+            outputs=[self.ie, self.p, self.q, self.cs, self.stress],
+            device=d,
+        )
+
+    def step(self, dt: float, t: float) -> None:
+        """One MUSL step from t to t + dt [s]."""
+        self.to_grid(dt)
+        self.update_grid(dt)
+        self.to_particles(dt)
+        self.update_eos(dt, t)
+
+    def _geo_f(self):
+        x0, y0, ih, nx, ny, px, py, k, l = self._geo
+        return [F64(x0), F64(y0), F64(ih), nx, ny, px, py, k, F64(l)]
+
+    # ------------------------------------------------------------------ diagnostics
+    def stable_dt(self) -> float:
+        """alpha h / max(c + |v|) over active particles [s] (inf if none)."""
+        self._smax.zero_()
+        wp.launch(max_signal_speed, dim=self.n, inputs=[self.active, self.v, self.cs], outputs=[self._smax], device=self.device)
+        s = float(self._smax.numpy()[0])
+        return self.opts.cfl * self.spec.h / s if s > 0 else float("inf")
+
+    @property
+    def deactivated_count(self) -> int:
+        """Number of particles deactivated so far (left the grid or inverted)."""
+        return int(self._deactivated.numpy()[0])
+
+    def _act(self) -> np.ndarray:
+        return self.active.numpy().astype(bool)
+
+    def total_mass(self) -> float:
+        """Mass of the active particles [kg/m]."""
+        return float(self.mass.numpy()[self._act()].sum())
+
+    def total_momentum(self) -> np.ndarray:
+        """Momentum of the active particles [N s/m], shape [2]."""
+        a = self._act()
+        return (self.mass.numpy()[a, None] * self.v.numpy()[a]).sum(axis=0)
+
+    def energies(self) -> dict[str, float]:
+        """Energies of the active particles [J/m].
+
+        JWL: internal (sum ie), kinetic, total (internal + kinetic), released_chemical
+        (sum F E0 V0: chemical energy liberated by the burn), initial_internal (sum E0 V0)
+        and gas_work (initial_internal - internal: work done by the products so far).
+        Elastic: kinetic, strain, total.
+        """
+        a = self._act()
+        v = self.v.numpy()[a]
+        ke = 0.5 * float((self.mass.numpy()[a] * (v * v).sum(axis=1)).sum())
+        if not self.is_jwl:
+            m = self.material
+            w = strain_energy_density_np(self.stress.numpy()[a], m.E, m.nu)
+            se = float((w * self.vol.numpy()[a]).sum())
+            return {"kinetic": ke, "strain": se, "total": ke + se}
+        ie = float(self.ie.numpy()[a].sum())
+        chem0 = self._chem0[a]
+        return {
+            "internal": ie,
+            "kinetic": ke,
+            "total": ie + ke,
+            "released_chemical": float((self.burn.numpy()[a] * chem0).sum()),
+            "initial_internal": float(chem0.sum()),
+            "gas_work": float(chem0.sum() - ie),
+        }
+
+    def particle_fields(self) -> dict[str, np.ndarray]:
+        """Host copies of the active particles' fields for output (SI units).
+
+        position [n,2] m, velocity [n,2] m/s, pressure [n] Pa, density [n] kg/m^3,
+        burn_fraction [n], relative_volume [n], internal_energy [n] J/m, volume [n] m^2.
+        """
+        a = self._act()
+        return {
+            "position": self.x.numpy()[a].copy(),
+            "velocity": self.v.numpy()[a].copy(),
+            "pressure": self.p.numpy()[a].copy(),
+            "density": self.rho.numpy()[a].copy(),
+            "burn_fraction": self.burn.numpy()[a].copy(),
+            "relative_volume": (self.vol.numpy() / self.vol0.numpy())[a],
+            "internal_energy": self.ie.numpy()[a].copy(),
+            "volume": self.vol.numpy()[a].copy(),
+        }
+
+    def pressure_at(self, points: np.ndarray) -> np.ndarray:
+        """Gas pressure [Pa] at points [k,2] [m]: mass-weighted B-spline average of particle pressures.
+
+        Only particles within 1.5 h per axis contribute; 0 where there are none.
+        """
+        from scipy.spatial import cKDTree
+
+        pts = np.atleast_2d(np.asarray(points, F64))
+        a = self._act()
+        xp, pp, mp = self.x.numpy()[a], self.p.numpy()[a], self.mass.numpy()[a]
+        out = np.zeros(len(pts))
+        if len(xp) == 0:
+            return out
+        h = self.spec.h
+        tree = cKDTree(xp)
+        for k, nb in enumerate(tree.query_ball_point(pts, r=1.5 * np.sqrt(2.0) * h)):
+            if not nb:
+                continue
+            r = (xp[nb] - pts[k]) / h
+            w = shape_1d_np(r[:, 0])[0] * shape_1d_np(r[:, 1])[0] * mp[nb]
+            if w.sum() > 0:
+                out[k] = float((w * pp[nb]).sum() / w.sum())
+        return out
+
+    def set_light_times(self, t_light: np.ndarray) -> None:
+        """Override the lighting times [s] (e.g. a plane-wave initiation)."""
+        self.light_time.assign(np.asarray(t_light, F64))
+
+    def cj_check(self) -> dict:
+        """The CJ consistency report of the JWL set (see :func:`blastfrac.explosives.library.cj_report`)."""
+        from blastfrac.explosives.library import cj_report
+
+        name = self.config.name if self.config is not None and self.config.name else "custom"
+        return cj_report(self.material, name)

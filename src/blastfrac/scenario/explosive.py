@@ -1,0 +1,149 @@
+"""Scenario section ``[explosive]``: the MPM detonation-products model (pydantic v2).
+
+SI units throughout.  The explosive is either a library name (``name``) or a full
+custom JWL set (``constants``), never both.  Example::
+
+    [explosive]
+    name = "emulsion"
+    charges = [{ kind = "circle", center = [0.0, 0.0], radius = 0.02 }]
+    detonation_points = [{ position = [0.0, 0.0], delay = 0.0 }]
+    [explosive.grid]
+    cell_size = 0.002
+    margin = 0.06
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+Point = tuple[float, float]
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+
+class JWLConstants(_Model):
+    """A custom JWL set with its detonation velocity."""
+
+    rho0: float = Field(gt=0, le=5000, description="initial explosive density [kg/m^3]")
+    D: float = Field(gt=0, le=12000, description="detonation velocity used for lighting times [m/s]")
+    A: float = Field(ge=0, description="JWL coefficient A [Pa]")
+    B: float = Field(ge=0, description="JWL coefficient B [Pa]")
+    R1: float = Field(gt=0, le=20, description="JWL exponent R1 [-]")
+    R2: float = Field(gt=0, le=20, description="JWL exponent R2 [-]")
+    omega: float = Field(gt=0, le=3, description="JWL Grueneisen coefficient omega [-]")
+    E0: float = Field(gt=0, le=5e10, description="detonation energy per unit initial volume [J/m^3]")
+
+
+class CircleCharge(_Model):
+    """A circular charge (a borehole section in plane strain)."""
+
+    kind: Literal["circle"] = Field(description="charge shape tag")
+    center: Point = Field(description="centre (x, y) [m]")
+    radius: float = Field(gt=0, description="radius [m]")
+
+
+class PolygonCharge(_Model):
+    """A polygonal charge; vertices in order (either orientation)."""
+
+    kind: Literal["polygon"] = Field(description="charge shape tag")
+    vertices: list[Point] = Field(min_length=3, description="vertices (x, y) [m], at least 3")
+
+
+Charge = Annotated[CircleCharge | PolygonCharge, Field(discriminator="kind")]
+
+
+class DetonationPoint(_Model):
+    """An initiation point; lighting time t_l = |X - position| / D + delay."""
+
+    position: Point = Field(description="initiation point (x, y) [m]")
+    delay: float = Field(default=0.0, ge=0, description="initiation delay [s]")
+
+
+class GridConfig(_Model):
+    """Background grid; bounds win over margin when both are given."""
+
+    cell_size: float = Field(gt=0, description="grid cell size h [m]")
+    bounds: tuple[Point, Point] | None = Field(
+        default=None, description="grid box ((xmin, ymin), (xmax, ymax)) [m]; default: charges' box plus margin"
+    )
+    margin: float | None = Field(
+        default=None, ge=0, description="clearance added around the charges' box [m]; default: the box's larger side"
+    )
+    points_per_cell: int = Field(default=2, ge=1, le=6, description="material points per cell per direction [-]")
+
+    @model_validator(mode="after")
+    def _check_bounds(self) -> GridConfig:
+        if self.bounds is not None:
+            (x0, y0), (x1, y1) = self.bounds
+            if not (x1 > x0 and y1 > y0):
+                raise ValueError("grid.bounds must be ((xmin, ymin), (xmax, ymax)) with xmax > xmin and ymax > ymin")
+        return self
+
+
+class BurnConfig(_Model):
+    """Programmed burn (METHOD §2.4)."""
+
+    mode: Literal["combined", "time", "volumetric", "instant"] = Field(
+        default="combined", description="burn law: max(time, volumetric), one of them, or all burnt at t=0"
+    )
+    width_factor: float = Field(
+        default=1.5, gt=0, le=10, description="time-burn width in particle lengths (F1 = (t-t_l) D / (k h_e)) [-]"
+    )
+    p_cj: float | None = Field(
+        default=None, gt=0, description="CJ pressure for the volumetric burn [Pa]; default: from the JWL Hugoniot"
+    )
+
+
+class ExplosiveConfig(_Model):
+    """MPM explosive section: JWL set, charges, initiation, grid and numerical options."""
+
+    name: str | None = Field(default=None, description="library explosive: emulsion, petn, tnt, anfo")
+    constants: JWLConstants | None = Field(default=None, description="custom JWL set (instead of name)")
+    charges: list[Charge] = Field(min_length=1, description="charge regions filled with material points")
+    detonation_points: list[DetonationPoint] = Field(
+        default_factory=list, description="initiation points; default: the centroid of each charge, no delay"
+    )
+    grid: GridConfig = Field(description="background grid")
+    shape: Literal["bspline2", "ugimp"] = Field(
+        default="bspline2", description="shape functions: quadratic B-spline or uGIMP (l_p = h/(2 ppc))"
+    )
+    flip: float = Field(default=0.99, ge=0, le=1, description="FLIP fraction of the FLIP/PIC velocity blend [-]")
+    cfl: float = Field(default=0.2, gt=0, le=0.5, description="CFL factor alpha in dt = alpha h / max(c + |v|) [-]")
+    q1: float = Field(default=1.5, ge=0, le=10, description="quadratic artificial-viscosity coefficient Q1 [-]")
+    q2: float = Field(default=0.06, ge=0, le=2, description="linear artificial-viscosity coefficient Q2 [-]")
+    mass_cutoff: float = Field(
+        default=1e-5, ge=0, lt=1, description="node mass cut-off as a fraction of rho0 h^2 (per unit thickness) [-]"
+    )
+    v_max: float = Field(
+        default=100.0, gt=1, description="relative volume beyond which the products' pressure is frozen to 0 [-]"
+    )
+    burn: BurnConfig = Field(default_factory=BurnConfig, description="programmed burn options")
+
+    @model_validator(mode="after")
+    def _one_source(self) -> ExplosiveConfig:
+        if (self.name is None) == (self.constants is None):
+            raise ValueError("give exactly one of explosive.name (library) or explosive.constants (custom JWL set)")
+        if self.name is not None:
+            from blastfrac.explosives.library import get_explosive
+
+            try:
+                get_explosive(self.name)
+            except KeyError as exc:
+                raise ValueError(str(exc.args[0])) from None
+        return self
+
+    def jwl(self):
+        """The resolved :class:`blastfrac.materials.jwl.JWLParams`."""
+        from blastfrac.explosives.library import get_explosive
+        from blastfrac.materials.jwl import JWLParams
+
+        if self.constants is not None:
+            return JWLParams(**self.constants.model_dump())
+        return get_explosive(self.name)
+
+
+__all__ = ["ExplosiveConfig", "JWLConstants", "CircleCharge", "PolygonCharge", "DetonationPoint", "GridConfig", "BurnConfig"]

@@ -1,0 +1,459 @@
+"""Scenario schema: the validated, documented description of one blastfrac run.
+
+Every user-facing option lives here, with its SI unit and allowed range in the field
+description. Unknown keys are rejected (``extra="forbid"``) so that a typo is an error,
+not a silently ignored setting. The resolved scenario (all defaults filled in) is
+written beside the results as ``resolved.toml``.
+
+Sign conventions: continuum stress is positive in tension, so an in-situ compressive
+stress of 15 MPa is ``syy = -15e6``. Lengths are metres, times seconds, stresses
+pascals, angles degrees (as users quote friction angles), energies J/m².
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+Point = tuple[float, float]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+
+
+# --------------------------------------------------------------------------- simulation
+class SimulationConfig(_Strict):
+    """Clock, time step and compute device."""
+
+    end_time: float = Field(1e-4, gt=0, description="Simulated end time of the dynamic stage [s].")
+    dt_safety: float = Field(
+        0.8, gt=0, le=1.0, description="Safety factor applied to the Gershgorin stable time step (0, 1]."
+    )
+    device: str = Field("cpu", pattern=r"^(cpu|cuda(:\d+)?)$", description="Warp device: 'cpu', 'cuda' or 'cuda:N'.")
+    damping: float = Field(
+        0.0, ge=0, lt=1, description="Cundall local damping factor of the dynamic stage [-]; 0 for blasts."
+    )
+    seed: int = Field(0, ge=0, description="Seed for mesh generation and any random field.")
+    max_steps: int | None = Field(None, gt=0, description="Stop after this many steps even before end_time.")
+    progress: bool = Field(True, description="Show a progress bar on the terminal.")
+
+
+# --------------------------------------------------------------------------- output
+class OutputConfig(_Strict):
+    """Where and how often results are written."""
+
+    directory: str = Field("out", description="Output directory (created if missing).")
+    interval: float | None = Field(
+        None, gt=0, description="Time between ParaView frames [s]; default end_time/20."
+    )
+    monitor_interval: float | None = Field(
+        None, gt=0, description="Time between monitor/fracture-history samples [s]; default end_time/200."
+    )
+    paraview: bool = Field(True, description="Write the ParaView (VTU + PVD) time series of the rock.")
+    figures: bool = Field(True, description="Write PNG figures at the end of the run.")
+
+
+# --------------------------------------------------------------------------- rock
+class RockConfig(_Strict):
+    """Rock: elastic blocks (CST) and the breakable interface springs between them."""
+
+    density: float = Field(2600.0, gt=0, description="Mass density [kg/m³].")
+    youngs_modulus: float = Field(50e9, gt=0, description="Young's modulus of the blocks [Pa].")
+    poisson_ratio: float = Field(0.2, ge=0, lt=0.5, description="Poisson's ratio of the blocks [-], in [0, 0.5).")
+    stiffness_mode: Literal["penalty", "per_area"] = Field(
+        "penalty",
+        description="'penalty': kn = ks = spring_penalty·E'/h (h mean element height of the edge); "
+        "'per_area': kn, ks given directly in Pa/m as in the paper's Table 3.",
+    )
+    spring_penalty: float = Field(
+        20.0, gt=0, description="Penalty factor β on E'/h used when stiffness_mode='penalty' [-]."
+    )
+    kn: float | None = Field(None, gt=0, description="Normal spring stiffness per unit area [Pa/m] (per_area mode).")
+    ks: float | None = Field(None, gt=0, description="Shear spring stiffness per unit area [Pa/m] (per_area mode).")
+    tensile_strength: float = Field(10e6, ge=0, description="Spring tensile strength T [Pa].")
+    cohesion: float = Field(40e6, ge=0, description="Spring cohesion c [Pa].")
+    friction_angle: float = Field(40.0, ge=0, lt=90, description="Spring internal friction angle φ [deg].")
+    residual_friction_angle: float | None = Field(
+        None, ge=0, lt=90, description="Friction angle of broken interfaces and block contact [deg]; default φ."
+    )
+    tensile_fracture_energy: float | None = Field(
+        None, gt=0, description="Mode I fracture energy G_fI [J/m²]; enables linear tension softening."
+    )
+    shear_fracture_energy: float | None = Field(
+        None, gt=0, description="Mode II fracture energy G_fII [J/m²]; enables linear cohesion softening."
+    )
+    unbreakable: bool = Field(False, description="Springs never fail (elastic verification runs).")
+
+    @model_validator(mode="after")
+    def _check_stiffness(self) -> "RockConfig":
+        if self.stiffness_mode == "per_area" and (self.kn is None or self.ks is None):
+            raise ValueError("stiffness_mode='per_area' needs both rock.kn and rock.ks [Pa/m]")
+        for gf, s, name in (
+            (self.tensile_fracture_energy, self.tensile_strength, "tensile"),
+            (self.shear_fracture_energy, self.cohesion, "shear"),
+        ):
+            if gf is not None and s == 0:
+                raise ValueError(f"{name}_fracture_energy given but the matching strength is 0")
+        return self
+
+    @property
+    def residual_friction(self) -> float:
+        """Residual friction angle [deg] (φ_r, defaults to φ)."""
+        return self.friction_angle if self.residual_friction_angle is None else self.residual_friction_angle
+
+    @property
+    def plane_strain_modulus(self) -> float:
+        """E' = E/(1-ν²) [Pa]."""
+        return self.youngs_modulus / (1.0 - self.poisson_ratio**2)
+
+    @property
+    def p_wave_speed(self) -> float:
+        """Plane-strain P-wave speed c_p = sqrt((λ+2G)/ρ) [m/s]."""
+        e, nu = self.youngs_modulus, self.poisson_ratio
+        return math.sqrt(e * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / self.density)
+
+    @property
+    def s_wave_speed(self) -> float:
+        """Shear-wave speed c_s = sqrt(G/ρ) [m/s]."""
+        return math.sqrt(self.youngs_modulus / (2 * (1 + self.poisson_ratio)) / self.density)
+
+
+# --------------------------------------------------------------------------- geometry
+class RectangleDomain(_Strict):
+    type: Literal["rectangle"] = "rectangle"
+    width: float = Field(gt=0, description="Width along x [m].")
+    height: float = Field(gt=0, description="Height along y [m].")
+    center: Point = Field((0.0, 0.0), description="Centre [m].")
+
+    def contains(self, p: Point, margin: float = 0.0) -> bool:
+        return (
+            abs(p[0] - self.center[0]) <= self.width / 2 - margin
+            and abs(p[1] - self.center[1]) <= self.height / 2 - margin
+        )
+
+    @property
+    def sides(self) -> tuple[str, ...]:
+        return ("bottom", "right", "top", "left")
+
+
+class DiscDomain(_Strict):
+    type: Literal["disc"] = "disc"
+    radius: float = Field(gt=0, description="Radius [m].")
+    center: Point = Field((0.0, 0.0), description="Centre [m].")
+
+    def contains(self, p: Point, margin: float = 0.0) -> bool:
+        return math.dist(p, self.center) <= self.radius - margin
+
+    @property
+    def sides(self) -> tuple[str, ...]:
+        return ("outer",)
+
+
+class PolygonDomain(_Strict):
+    type: Literal["polygon"] = "polygon"
+    vertices: list[Point] = Field(min_length=3, description="Vertices in counter-clockwise order [m].")
+
+    @model_validator(mode="after")
+    def _ccw(self) -> "PolygonDomain":
+        v = self.vertices
+        area2 = sum(v[i][0] * v[(i + 1) % len(v)][1] - v[(i + 1) % len(v)][0] * v[i][1] for i in range(len(v)))
+        if area2 <= 0:
+            raise ValueError("polygon vertices must be counter-clockwise and enclose a positive area")
+        return self
+
+    def contains(self, p: Point, margin: float = 0.0) -> bool:
+        v, inside = self.vertices, False
+        n = len(v)
+        for i in range(n):
+            (x1, y1), (x2, y2) = v[i], v[(i + 1) % n]
+            if (y1 > p[1]) != (y2 > p[1]) and p[0] < (x2 - x1) * (p[1] - y1) / (y2 - y1) + x1:
+                inside = not inside
+        if not inside or margin == 0.0:
+            return inside
+        return all(_seg_dist(p, v[i], v[(i + 1) % n]) >= margin for i in range(n))
+
+    @property
+    def sides(self) -> tuple[str, ...]:
+        return tuple(f"side{i}" for i in range(len(self.vertices)))
+
+
+def _seg_dist(p: Point, a: Point, b: Point) -> float:
+    ax, ay = b[0] - a[0], b[1] - a[1]
+    t = max(0.0, min(1.0, ((p[0] - a[0]) * ax + (p[1] - a[1]) * ay) / (ax * ax + ay * ay)))
+    return math.dist(p, (a[0] + t * ax, a[1] + t * ay))
+
+
+Domain = Annotated[Union[RectangleDomain, DiscDomain, PolygonDomain], Field(discriminator="type")]
+
+
+class Borehole(_Strict):
+    center: Point = Field((0.0, 0.0), description="Centre of the borehole [m].")
+    radius: float = Field(gt=0, description="Borehole radius r_b [m].")
+    mesh_size: float | None = Field(None, gt=0, description="Element size on this wall [m]; default geometry.mesh_size_near.")
+
+
+class GeometryConfig(_Strict):
+    """Rock domain, boreholes and mesh sizes (meshed by gmsh) or an external .msh file."""
+
+    domain: Domain = Field(description="Outer domain: rectangle, disc or polygon.")
+    boreholes: list[Borehole] = Field(default_factory=list, description="Circular holes in the rock.")
+    mesh_size: float = Field(gt=0, description="Element size far from the boreholes [m].")
+    mesh_size_near: float | None = Field(None, gt=0, description="Element size at the borehole walls [m]; default mesh_size.")
+    refinement_distance: float | None = Field(
+        None, gt=0, description="Distance from a wall over which the size grows to mesh_size [m]; default 10·r_b."
+    )
+    mesh_file: str | None = Field(None, description="Use this gmsh .msh file instead of meshing (path relative to the scenario).")
+    mesh_algorithm: Literal["delaunay", "frontal-delaunay"] = Field(
+        "frontal-delaunay", description="gmsh 2D algorithm."
+    )
+
+    @model_validator(mode="after")
+    def _holes_inside(self) -> "GeometryConfig":
+        for i, b in enumerate(self.boreholes):
+            if not self.domain.contains(b.center, margin=b.radius):
+                raise ValueError(
+                    f"boreholes[{i}] (centre {b.center}, radius {b.radius} m) is not fully inside the domain"
+                )
+        for i in range(len(self.boreholes)):
+            for j in range(i + 1, len(self.boreholes)):
+                bi, bj = self.boreholes[i], self.boreholes[j]
+                if math.dist(bi.center, bj.center) <= bi.radius + bj.radius:
+                    raise ValueError(f"boreholes[{i}] and boreholes[{j}] overlap")
+        if self.mesh_size_near is not None and self.mesh_size_near > self.mesh_size:
+            raise ValueError("mesh_size_near must not exceed mesh_size")
+        return self
+
+
+# --------------------------------------------------------------------------- loads
+class ConstantPulse(_Strict):
+    type: Literal["constant"] = "constant"
+    value: float = Field(description="Pressure [Pa] (positive pushes on the surface).")
+
+    def __call__(self, t: float) -> float:
+        return self.value
+
+
+class ExponentialPulse(_Strict):
+    """p(t) = p0·(exp(-a t) - exp(-b t)) normalised so that its peak equals ``peak``."""
+
+    type: Literal["exponential"] = "exponential"
+    peak: float = Field(gt=0, description="Peak pressure [Pa].")
+    rise_time: float = Field(gt=0, description="Time to peak [s].")
+    decay_time: float = Field(gt=0, description="e-folding decay time after the peak [s] (must exceed rise_time/2).")
+
+    def __call__(self, t: float) -> float:
+        if t <= 0:
+            return 0.0
+        a = 1.0 / self.decay_time
+        b = _rise_rate(a, self.rise_time)
+        tp = math.log(b / a) / (b - a)
+        norm = math.exp(-a * tp) - math.exp(-b * tp)
+        return self.peak * (math.exp(-a * t) - math.exp(-b * t)) / norm
+
+
+def _rise_rate(a: float, tr: float) -> float:
+    """Solve ln(b/a)/(b-a) = tr for b > a (bisection on a monotone function)."""
+    lo, hi = a * (1 + 1e-9), a * 1e9
+    if math.log(hi / a) / (hi - a) > tr:
+        return hi
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        if math.log(mid / a) / (mid - a) > tr:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+class TrianglePulse(_Strict):
+    type: Literal["triangle"] = "triangle"
+    peak: float = Field(gt=0, description="Peak pressure [Pa].")
+    rise_time: float = Field(gt=0, description="Linear rise to the peak [s].")
+    duration: float = Field(gt=0, description="Total duration (linear decay to zero at this time) [s].")
+
+    @model_validator(mode="after")
+    def _order(self) -> "TrianglePulse":
+        if self.duration <= self.rise_time:
+            raise ValueError("duration must exceed rise_time")
+        return self
+
+    def __call__(self, t: float) -> float:
+        if t <= 0 or t >= self.duration:
+            return 0.0
+        if t < self.rise_time:
+            return self.peak * t / self.rise_time
+        return self.peak * (self.duration - t) / (self.duration - self.rise_time)
+
+
+class TablePulse(_Strict):
+    type: Literal["table"] = "table"
+    times: list[float] = Field(min_length=2, description="Times [s], increasing.")
+    values: list[float] = Field(min_length=2, description="Pressures [Pa] at those times (linear in between, 0 outside).")
+
+    @model_validator(mode="after")
+    def _same_length(self) -> "TablePulse":
+        if len(self.times) != len(self.values):
+            raise ValueError("times and values must have the same length")
+        if any(b <= a for a, b in zip(self.times, self.times[1:])):
+            raise ValueError("times must be strictly increasing")
+        return self
+
+    def __call__(self, t: float) -> float:
+        if t < self.times[0] or t > self.times[-1]:
+            return 0.0
+        for i in range(len(self.times) - 1):
+            if t <= self.times[i + 1]:
+                w = (t - self.times[i]) / (self.times[i + 1] - self.times[i])
+                return self.values[i] + w * (self.values[i + 1] - self.values[i])
+        return self.values[-1]
+
+
+Pulse = Annotated[
+    Union[ConstantPulse, ExponentialPulse, TrianglePulse, TablePulse], Field(discriminator="type")
+]
+
+
+class BoreholePressure(_Strict):
+    """A prescribed pressure history on a borehole wall (rock-only blast loading)."""
+
+    borehole: int = Field(0, ge=0, description="Index into geometry.boreholes.")
+    pulse: Pulse = Field(description="Pressure history p(t).")
+
+
+# --------------------------------------------------------------------------- boundaries
+class BoundarySide(_Strict):
+    type: Literal["free", "fixed", "roller", "viscous", "pressure"] = Field(
+        "free",
+        description="free; fixed (u = 0); roller (normal displacement 0, free to slide); "
+        "viscous (Lysmer–Kuhlemeyer dashpots, non-reflecting); pressure (applied pulse).",
+    )
+    pulse: Pulse | None = Field(None, description="Pressure history for type='pressure'.")
+
+    @model_validator(mode="after")
+    def _pulse(self) -> "BoundarySide":
+        if self.type == "pressure" and self.pulse is None:
+            raise ValueError("type='pressure' needs a pulse")
+        if self.type != "pressure" and self.pulse is not None:
+            raise ValueError(f"a pulse is only allowed with type='pressure' (got type='{self.type}')")
+        return self
+
+
+# --------------------------------------------------------------------------- in-situ stress
+class InSituConfig(_Strict):
+    """Far-field (pre-existing) stress applied as a quasi-static stage before the dynamic one."""
+
+    sxx: float = Field(0.0, description="Far-field σxx [Pa], tension positive (compression negative).")
+    syy: float = Field(0.0, description="Far-field σyy [Pa], tension positive.")
+    sxy: float = Field(0.0, description="Far-field τxy [Pa].")
+    method: Literal["relax", "initial"] = Field(
+        "relax",
+        description="'relax': initialise σ⁰, apply consistent tractions and relax quasi-statically (METHOD §1.8); "
+        "'initial': only initialise σ⁰ and tractions, no relaxation.",
+    )
+    damping: float = Field(0.8, gt=0, lt=1, description="Local damping of the relaxation stage [-].")
+    tolerance: float = Field(1e-5, gt=0, description="Stop when kinetic energy / external work falls below this.")
+    max_steps: int = Field(200_000, gt=0, description="Upper bound on relaxation steps.")
+    allow_failure: bool = Field(
+        True, description="Let springs fail during relaxation (failures are always reported in the summary)."
+    )
+
+    @property
+    def active(self) -> bool:
+        return any(v != 0.0 for v in (self.sxx, self.syy, self.sxy))
+
+
+# --------------------------------------------------------------------------- monitors and zones
+MonitorQuantity = Literal["ux", "uy", "vx", "vy", "speed", "sxx", "syy", "sxy", "pressure", "gas_pressure"]
+
+
+class Monitor(_Strict):
+    name: str = Field(pattern=r"^[A-Za-z0-9_\-]+$", description="Column prefix in monitors.csv.")
+    position: Point = Field(description="Point [m]; the rock element/node containing it is sampled.")
+    quantities: list[MonitorQuantity] = Field(
+        default_factory=lambda: ["vx", "vy", "sxx", "syy", "sxy", "pressure"],
+        description="Quantities: ux, uy, vx, vy, speed, sxx, syy, sxy, pressure (=-(sxx+syy)/2 in rock), gas_pressure.",
+    )
+
+
+class AnnulusZone(_Strict):
+    type: Literal["annulus"] = "annulus"
+    name: str
+    center: Point = (0.0, 0.0)
+    r_inner: float = Field(ge=0, description="Inner radius [m].")
+    r_outer: float = Field(gt=0, description="Outer radius [m].")
+
+    @model_validator(mode="after")
+    def _radii(self) -> "AnnulusZone":
+        if self.r_outer <= self.r_inner:
+            raise ValueError("r_outer must exceed r_inner")
+        return self
+
+
+class SectorZone(AnnulusZone):
+    type: Literal["sector"] = "sector"  # type: ignore[assignment]
+    angle_start: float = Field(description="Start angle [deg], counter-clockwise from +x.")
+    angle_end: float = Field(description="End angle [deg].")
+
+
+class RectangleZone(_Strict):
+    type: Literal["rectangle"] = "rectangle"
+    name: str
+    xmin: float
+    xmax: float
+    ymin: float
+    ymax: float
+
+    @model_validator(mode="after")
+    def _order(self) -> "RectangleZone":
+        if self.xmax <= self.xmin or self.ymax <= self.ymin:
+            raise ValueError("need xmin < xmax and ymin < ymax")
+        return self
+
+
+Zone = Annotated[Union[AnnulusZone, SectorZone, RectangleZone], Field(discriminator="type")]
+
+
+# --------------------------------------------------------------------------- scenario
+class Scenario(_Strict):
+    """A complete blastfrac run."""
+
+    title: str = Field("", description="Free text shown in the summary and figures.")
+    simulation: SimulationConfig = Field(default_factory=SimulationConfig)
+    output: OutputConfig = Field(default_factory=OutputConfig)
+    rock: RockConfig = Field(default_factory=RockConfig)
+    geometry: GeometryConfig
+    boundaries: dict[str, BoundarySide] = Field(
+        default_factory=dict,
+        description="Per side: rectangle sides 'bottom','right','top','left'; disc 'outer'; polygon 'side0'..; "
+        "borehole walls 'hole0'.. (default free).",
+    )
+    borehole_pressure: list[BoreholePressure] = Field(default_factory=list)
+    insitu: InSituConfig = Field(default_factory=InSituConfig)
+    monitors: list[Monitor] = Field(default_factory=list)
+    zones: list[Zone] = Field(default_factory=list)
+
+    @model_validator(mode="after")
+    def _cross_checks(self) -> "Scenario":
+        sides = set(self.geometry.domain.sides) | {f"hole{i}" for i in range(len(self.geometry.boreholes))}
+        for name in self.boundaries:
+            if name not in sides:
+                raise ValueError(f"boundaries.{name}: unknown side; this domain has {sorted(sides)}")
+        for i, bp in enumerate(self.borehole_pressure):
+            if bp.borehole >= len(self.geometry.boreholes):
+                raise ValueError(
+                    f"borehole_pressure[{i}].borehole = {bp.borehole} but only {len(self.geometry.boreholes)} boreholes exist"
+                )
+        names = [m.name for m in self.monitors]
+        if len(set(names)) != len(names):
+            raise ValueError("monitor names must be unique")
+        if self.geometry.mesh_file is None:
+            for i, m in enumerate(self.monitors):
+                if not self.geometry.domain.contains(m.position):
+                    raise ValueError(f"monitors[{i}] ({m.name}) at {m.position} is outside the domain")
+        return self
+
+    def boundary(self, side: str) -> BoundarySide:
+        return self.boundaries.get(side, BoundarySide())
