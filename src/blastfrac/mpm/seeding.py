@@ -98,3 +98,19 @@ def seed_charges(charges, spec, ppc: int, exact_area: bool = True):
         vol_all.append(vol)
         cid_all.append(np.full(len(pts), k, dtype=np.int32))
     return np.concatenate(xs_all), np.concatenate(vol_all), np.concatenate(cid_all)
+
+
+def slab_1d(length: float, ncell: int, ppc: int = 2, pad: int = 3):
+    """A genuinely 1D setup: material on 0 <= x <= length in a strip one cell wide, periodic in y.
+
+    Returns (GridSpec, x [n,2] m, vol [n] m^2); the grid has ``pad`` cells beyond each end
+    (add a wall at x = 0 with ``Grid.set_walls(xmin=0.0)``).
+    """
+    from blastfrac.mpm.grid import GridSpec
+
+    h = length / ncell
+    spec = GridSpec(x0=-pad * h, y0=0.0, h=h, nx=ncell + 2 * pad + 1, ny=1, periodic_y=True)
+    xs = (np.arange(ppc * ncell) + 0.5) * h / ppc
+    ys = (np.arange(ppc) + 0.5) * h / ppc
+    x = np.stack([np.repeat(xs, ppc), np.tile(ys, len(xs))], axis=1)
+    return spec, x, np.full(len(x), (h / ppc) ** 2)

@@ -46,7 +46,7 @@ class MPMOptions:
 
     shape: str = "bspline2"
     ppc: int = 2
-    flip: float = 0.99
+    flip: float = 1.0
     cfl: float = 0.2
     q1: float = 1.5
     q2: float = 0.06
@@ -168,6 +168,12 @@ class MPMSolver:
             self.ie.assign(P.E0 * vol)
             c0 = np.sqrt(jwl_sound_speed_sq_np(1.0, P.E0, 0.0, P.rho0, P.A, P.B, P.R1, P.R2, P.omega))
             self.cs.assign(np.full(n, max(float(c0), P.D)))
+            if burn is not None:  # products already (partly) burnt: pressure and stress consistent with F
+                from blastfrac.materials.jwl import jwl_pressure_np
+
+                p0 = np.asarray(burn, F64) * jwl_pressure_np(1.0, P.E0, P.A, P.B, P.R1, P.R2, P.omega)
+                self.p.assign(p0)
+                self.stress.assign(-p0[:, None, None] * np.eye(2)[None])
             self._chem0 = P.E0 * vol
         else:
             self.cs.assign(np.full(n, material.p_wave_speed))

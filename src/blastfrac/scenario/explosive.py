@@ -111,7 +111,9 @@ class ExplosiveConfig(_Model):
     shape: Literal["bspline2", "ugimp"] = Field(
         default="bspline2", description="shape functions: quadratic B-spline or uGIMP (l_p = h/(2 ppc))"
     )
-    flip: float = Field(default=0.99, ge=0, le=1, description="FLIP fraction of the FLIP/PIC velocity blend [-]")
+    flip: float = Field(
+        default=1.0, ge=0, le=1, description="FLIP fraction of the FLIP/PIC velocity blend (1 = pure FLIP, as MPM3D) [-]"
+    )
     cfl: float = Field(default=0.2, gt=0, le=0.5, description="CFL factor alpha in dt = alpha h / max(c + |v|) [-]")
     q1: float = Field(default=1.5, ge=0, le=10, description="quadratic artificial-viscosity coefficient Q1 [-]")
     q2: float = Field(default=0.06, ge=0, le=2, description="linear artificial-viscosity coefficient Q2 [-]")

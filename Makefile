@@ -1,0 +1,37 @@
+# blastfrac: two-command quick start (`make demo`, `make test`) on a machine with Python 3.11+ and make.
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+DEMO   := examples/borehole_pulse/scenario.toml
+
+.PHONY: demo test validate bench clean
+
+$(VENV)/.installed: pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e .
+	touch $@
+
+$(VENV)/.installed-test: $(VENV)/.installed
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $@
+
+## demo: create .venv, install, run the default scenario and write its figures to out/demo
+demo: $(VENV)/.installed
+	$(BIN)/blastfrac run $(DEMO) --out out/demo
+	@echo "figures: out/demo/fracture_pattern.png out/demo/displacement.png out/demo/*.png"
+
+## test: install the test extras and run the test suite (no slow tests)
+test: $(VENV)/.installed-test
+	$(BIN)/python -m pytest -q
+
+## validate: long verification and validation runs (not in CI)
+validate: $(VENV)/.installed-test
+	$(BIN)/python -m pytest -q -m slow
+
+## bench: performance suite (throughput and scaling), results printed and appended to benchmarks/
+bench: $(VENV)/.installed
+	$(BIN)/blastfrac bench
+
+clean:
+	rm -rf out .pytest_cache

@@ -1,0 +1,61 @@
+"""``blastfrac check SCENARIO``: validate and report what would run, without running."""
+
+from __future__ import annotations
+
+import math
+
+from .common import add_scenario_args, load
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("check", help="validate a scenario and print what would run")
+    add_scenario_args(p)
+    p.set_defaults(func=run)
+
+
+def model_bytes(model) -> int:
+    import warp as wp
+
+    total = 0
+    for v in vars(model).values():
+        if isinstance(v, wp.array):
+            total += v.capacity
+    return total
+
+
+def run(args) -> int:
+    from ..scenario import ScenarioError
+    from ..model.builder import ModelBuilder
+
+    sc = load(args)
+    try:
+        b = ModelBuilder(sc)
+    except ValueError as e:
+        raise ScenarioError(str(e)) from None
+    m = b.finalize("cpu")
+    st = m.state()
+    import warp as wp
+
+    state_bytes = sum(v.capacity for v in vars(st).values() if isinstance(v, wp.array))
+    dt = sc.simulation.dt_safety * m.stable_dt
+    steps = math.ceil(sc.simulation.end_time / dt)
+    rows = [
+        ("title", sc.title or "-"),
+        ("device", sc.simulation.device),
+        ("elements (blocks)", f"{m.element_count}"),
+        ("nodes", f"{m.node_count}"),
+        ("springs (node pairs)", f"{m.spring_count} on {m.interface_count} interfaces"),
+        ("boreholes", f"{len(sc.geometry.boreholes)}"),
+        ("stable dt (Gershgorin)", f"{m.stable_dt:.4e} s"),
+        ("dt used (x dt_safety)", f"{dt:.4e} s"),
+        ("end time", f"{sc.simulation.end_time:.4e} s"),
+        ("steps to end time", f"{steps}" + (f" (capped at {sc.simulation.max_steps})" if sc.simulation.max_steps else "")),
+        ("in-situ stage", "yes" if sc.insitu.active else "no"),
+        ("memory (model + state)", f"{(model_bytes(m) + state_bytes) / 2**20:.1f} MiB"),
+        ("output directory", sc.output.directory),
+    ]
+    w = max(len(k) for k, _ in rows)
+    print(f"scenario {args.scenario}: valid")
+    for k, v in rows:
+        print(f"  {k:<{w}}  {v}")
+    return 0

@@ -1,0 +1,69 @@
+"""ParaView time series of the rock: one VTU per frame (via meshio) and a PVD index.
+
+Each frame holds the deformed blocks (triangles, with displacement and velocity at nodes and
+the stress tensor per element) and the cracks as line cells on the broken interfaces, with
+``crack_mode`` 1 = tensile, 2 = shear (mode of the first spring of the edge that broke).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import meshio
+import numpy as np
+
+
+def crack_segments(model, mode: np.ndarray, tbreak: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Broken interfaces as node index pairs on the e1 side, and their mode, shapes [K, 2], [K]."""
+    pm = mode.reshape(-1, 2)
+    tb = tbreak.reshape(-1, 2)
+    broken = np.flatnonzero((pm > 0).any(axis=1))
+    first = np.where((pm[broken, 0] > 0) & ((pm[broken, 1] == 0) | (tb[broken, 0] <= tb[broken, 1])), 0, 1)
+    crack_mode = pm[broken, first]
+    pn = model.topology.pair_nodes
+    seg = np.stack([pn[2 * broken, 0], pn[2 * broken + 1, 0]], 1)
+    return seg, crack_mode
+
+
+class ParaviewSeries:
+    def __init__(self, directory: Path, name: str = "rock"):
+        self.dir = Path(directory)
+        self.name = name
+        self.frames: list[tuple[float, str]] = []
+
+    def write(self, model, state, t: float) -> None:
+        x = state.x.numpy()
+        X = model.node_X.numpy()
+        v = state.v.numpy()
+        sig = state.sigma.numpy()
+        seg, cmode = crack_segments(model, state.pair_mode.numpy(), state.pair_tbreak.numpy())
+        pts = np.c_[x, np.zeros(len(x))]
+        tri = np.arange(len(x)).reshape(-1, 3)
+        cells = [("triangle", tri)]
+        n_e, n_c = len(tri), len(seg)
+        stress = np.zeros((n_e, 9))
+        stress[:, 0], stress[:, 4], stress[:, 1], stress[:, 3] = sig[:, 0], sig[:, 1], sig[:, 2], sig[:, 2]
+        cell_data = {"stress": [stress], "crack_mode": [np.zeros(n_e, np.int32)]}
+        if n_c:
+            cells.append(("line", seg))
+            cell_data["stress"].append(np.full((n_c, 9), np.nan))
+            cell_data["crack_mode"].append(cmode.astype(np.int32))
+        u = x - X
+        mesh = meshio.Mesh(
+            pts, cells,
+            point_data={"displacement": np.c_[u, np.zeros(len(u))], "velocity": np.c_[v, np.zeros(len(v))],
+                        "displacement_magnitude": np.linalg.norm(u, axis=1)},
+            cell_data=cell_data,
+        )
+        fname = f"{self.name}_{len(self.frames):04d}.vtu"
+        meshio.write(self.dir / fname, mesh, binary=True)
+        self.frames.append((t, fname))
+        self._write_pvd()
+
+    def _write_pvd(self) -> None:
+        rows = "\n".join(f'    <DataSet timestep="{t:.9e}" file={quoteattr(f)}/>' for t, f in self.frames)
+        (self.dir / f"{self.name}.pvd").write_text(
+            '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+            f"{rows}\n  </Collection>\n</VTKFile>\n"
+        )
