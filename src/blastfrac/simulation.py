@@ -34,6 +34,13 @@ class SimulationError(RuntimeError):
 class Simulation:
     def __init__(self, scenario: Scenario, out_dir: str | Path | None = None, device: str | None = None,
                  max_steps: int | None = None, mesh=None):
+        if scenario.explosive is not None:
+            from .scenario.errors import ScenarioError
+
+            raise ScenarioError(
+                "[explosive] is validated (see `blastfrac check`, `blastfrac explosive`) but the gas–rock coupling "
+                "is not implemented yet; load the borehole with [[borehole_pressure]] for now"
+            )
         self.scenario = scenario
         self.device = resolve_device(device or scenario.simulation.device)
         self.out_dir = Path(out_dir or scenario.output.directory)

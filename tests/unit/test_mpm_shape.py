@@ -90,3 +90,36 @@ def test_p2g_conserves_mass_momentum_and_reproduces_linear_velocity():
               outputs=[s.x, s.vol, s.vol_prev, s.rho, s.grad_v, dead])
     np.testing.assert_allclose(s.grad_v.numpy(), np.broadcast_to(G, (500, 2, 2)), atol=1e-10)
     np.testing.assert_allclose(s.vol.numpy() / s.vol_prev.numpy(), np.linalg.det(np.eye(2) + 1e-9 * G), rtol=1e-14)
+
+
+def test_seeding_polygon_circle_and_overlap():
+    from blastfrac.mpm import GridSpec
+    from blastfrac.mpm.seeding import seed_charges
+
+    spec = GridSpec.from_bounds((-1, -1), (1, 1), 0.01)
+    tri = {"kind": "polygon", "vertices": [(0.0, 0.0), (0.5, 0.0), (0.0, 0.4)]}
+    circ = {"kind": "circle", "center": [0.0, 0.0], "radius": 0.2}  # overlaps the triangle
+    x, vol, cid = seed_charges([tri, circ], spec, 2)
+    assert abs(vol[cid == 0].sum() - 0.5 * 0.5 * 0.4) < 1e-12  # exact polygon area
+    key = np.round(x / 0.005, 6)
+    assert len(np.unique(key, axis=0)) == len(x)  # no duplicate points in the overlap
+    assert abs((cid == 1).sum() * 0.005**2 - (np.pi * 0.04 - 0.25 * np.pi * 0.04)) < 0.02 * np.pi * 0.04
+    assert np.all(np.linalg.norm(x[cid == 1], axis=1) < 0.2)
+
+
+def test_pressure_at_uniform_field():
+    from blastfrac.explosives.library import get_explosive
+    from blastfrac.mpm import GridSpec, MPMOptions, MPMSolver
+    from blastfrac.mpm.seeding import seed_charges
+
+    P = get_explosive("tnt")
+    spec = GridSpec.from_bounds((-0.05, -0.05), (0.05, 0.05), 2e-3)
+    x, vol, _ = seed_charges([{"kind": "circle", "center": [0.0, 0.0], "radius": 0.02}], spec, 2)
+    s = MPMSolver.from_arrays(x, vol, spec, P, MPMOptions(), burn=np.ones(len(x)))
+    p0 = P.A * (1 - P.omega / P.R1) * np.exp(-P.R1) + P.B * (1 - P.omega / P.R2) * np.exp(-P.R2) + P.omega * P.E0
+    out = s.pressure_at(np.array([[0.0, 0.0], [0.01, -0.005], [0.04, 0.04]]))
+    np.testing.assert_allclose(out[:2], p0, rtol=1e-12)
+    assert out[2] == 0.0
+    f = s.particle_fields()
+    assert set(f) >= {"position", "velocity", "pressure", "density", "burn_fraction"}
+    assert f["position"].shape == (len(x), 2)

@@ -33,3 +33,19 @@ def test_free_expansion_conserves_mass_momentum_energy():
     assert np.abs(s.total_momentum()).max() < 1e-10 * np.abs(mv).sum()
     assert e["kinetic"] > 0.3 * e0["total"]  # a real expansion happened
     assert abs(e["total"] / e0["total"] - 1) < 0.01
+
+
+def test_particles_leaving_grid_are_deactivated_not_fatal():
+    P = get_explosive("petn")
+    spec = GridSpec.from_bounds((-0.012, -0.012), (0.012, 0.012), 1e-3)
+    x, vol, _ = seed_charges([{"kind": "circle", "center": [0.0, 0.0], "radius": 0.008}], spec, 2)
+    s = MPMSolver.from_arrays(x, vol, spec, P, MPMOptions(), burn=np.ones(len(x)))
+    t = 0.0
+    for _ in range(300):
+        dt = s.stable_dt()
+        s.step(dt, t)
+        t += dt
+    act = s.active.numpy().astype(bool)
+    assert s.deactivated_count == (~act).sum() > 0
+    assert abs(s.total_mass() - s.mass.numpy()[act].sum()) == 0
+    assert np.isfinite(s.particle_fields()["pressure"]).all() and np.isfinite(s.stable_dt())

@@ -54,6 +54,11 @@ def run(args) -> int:
         ("memory (model + state)", f"{(model_bytes(m) + state_bytes) / 2**20:.1f} MiB"),
         ("output directory", sc.output.directory),
     ]
+    if sc.explosive is not None:
+        from ..explosives.library import cj_report
+
+        rep = cj_report(sc.explosive.jwl(), sc.explosive.name or "custom")
+        rows.append(("explosive CJ check", rep["message"]))
     w = max(len(k) for k, _ in rows)
     print(f"scenario {args.scenario}: valid")
     for k, v in rows:

@@ -9,7 +9,7 @@ class ScenarioError(Exception):
     """A problem with the user's input (bad key, value, file). The CLI prints it and exits with 2."""
 
 
-_UNION_TAGS = {"rectangle", "disc", "polygon", "constant", "exponential", "triangle", "table", "annulus", "sector"}
+_UNION_TAGS = {"rectangle", "disc", "polygon", "constant", "exponential", "triangle", "table", "annulus", "sector", "circle"}
 
 
 def format_validation_error(err: ValidationError, source: str = "scenario") -> str:

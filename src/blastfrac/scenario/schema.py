@@ -17,6 +17,8 @@ from typing import Annotated, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from .explosive import ExplosiveConfig
+
 Point = tuple[float, float]
 
 
@@ -354,7 +356,11 @@ class InSituConfig(_Strict):
         description="'relax': initialise σ⁰, apply consistent tractions and relax quasi-statically (METHOD §1.8); "
         "'initial': only initialise σ⁰ and tractions, no relaxation.",
     )
-    damping: float = Field(0.8, gt=0, lt=1, description="Local damping of the relaxation stage [-].")
+    damping: float = Field(
+        0.3, gt=0, lt=1,
+        description="Cundall local damping of the relaxation stage [-]. 0.8 (a common DEM choice) over-damps the "
+        "low modes of a block model and relaxes far more slowly; 0.2-0.3 converges fastest in our tests.",
+    )
     tolerance: float = Field(1e-5, gt=0, description="Stop when kinetic energy / external work falls below this.")
     max_steps: int = Field(200_000, gt=0, description="Upper bound on relaxation steps.")
     allow_failure: bool = Field(
@@ -435,6 +441,9 @@ class Scenario(_Strict):
     insitu: InSituConfig = Field(default_factory=InSituConfig)
     monitors: list[Monitor] = Field(default_factory=list)
     zones: list[Zone] = Field(default_factory=list)
+    explosive: ExplosiveConfig | None = Field(
+        None, description="MPM explosive (JWL products, programmed burn); see blastfrac.scenario.explosive."
+    )
 
     @model_validator(mode="after")
     def _cross_checks(self) -> "Scenario":
