@@ -48,7 +48,10 @@ class Simulation:
         self.builder = ModelBuilder(scenario, mesh)
         self.model = self.builder.finalize(self.device)
         self.state = self.model.state()
-        self.cdem = CDEMSolver(self.model)
+        # Node-to-edge block contact (cdem/contact.py) is switched off: its kernel produces spurious forces on
+        # first contact (tests/verification/test_block_contact.py, xfail). Broken springs still act as
+        # unilateral frictional contacts until they separate.
+        self.cdem = CDEMSolver(self.model, block_contact=False)
         self.dt = scenario.simulation.dt_safety * self.model.stable_dt
         self.time = 0.0
         self.steps = 0

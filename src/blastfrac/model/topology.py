@@ -61,6 +61,8 @@ def build_topology(mesh: TriMesh) -> Topology:
     # any consistent choice works: the lower slot index is e1
     swap = s1 > s2
     s1, s2 = np.where(swap, s2, s1), np.where(swap, s1, s2)
+    o = np.argsort(s1, kind="stable")               # interfaces in element order: memory locality
+    s1, s2 = s1[o], s2[o]
     e1, k1 = s1 // 3, s1 % 3
     e2, k2 = s2 // 3, s2 % 3
     if not np.all(a[s1] == b[s2]) or not np.all(b[s1] == a[s2]):

@@ -1,0 +1,60 @@
+"""``blastfrac bench``: the performance suite (CDEM and MPM throughput, scaling slopes)."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("bench", help="run the performance benchmarks (throughput, scaling)")
+    p.add_argument("--device", default="cpu", help="cpu, cuda or cuda:N")
+    p.add_argument("--steps", type=int, default=20, help="timed steps per size")
+    p.add_argument("--quick", action="store_true", help="small sizes only (smoke run)")
+    p.add_argument("--only", choices=("cdem", "mpm"), default=None)
+    p.set_defaults(func=run)
+
+
+def _load(name: str):
+    """Import benchmarks/<name>.py from the source tree (the suite is not installed with the package)."""
+    root = Path(__file__).resolve().parents[3] / "benchmarks"
+    path = root / f"{name}.py"
+    if not path.is_file():
+        from ..scenario import ScenarioError
+
+        raise ScenarioError(f"benchmark suite not found at {root} (run from a source checkout)")
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def run(args) -> int:
+    from .._warp import resolve_device
+
+    device = resolve_device(args.device)
+    if args.only in (None, "cdem"):
+        cdem = _load("bench_cdem")
+        sizes = (5_000, 20_000) if args.quick else (50_000, 200_000, 800_000)
+        rows = cdem.run(sizes, args.steps, device)
+        print(f"CDEM on {device} (float64, all rock terms on)")
+        print("| elements | springs | steps | wall [s] | element-steps/s |")
+        for r in rows:
+            print(f"| {r['elements']:,} | {r['springs']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['element_steps_per_s']:.3e} |")
+        print(f"scaling slope: {cdem.scaling_slope(rows, 'elements'):.3f}\n")
+    if args.only in (None, "mpm"):
+        mpm = _load("bench_mpm")
+        sizes = (10_000, 40_000) if args.quick else (100_000, 400_000, 1_600_000)
+        rows = mpm.run(sizes, args.steps, device)
+        print(f"MPM on {device} (float64, full MUSL step)")
+        print("| particles | steps | wall [s] | particle-steps/s |")
+        for r in rows:
+            print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['particle_steps_per_s']:.3e} |")
+        n = [r["n_particles"] for r in rows]
+        t = [r["wall_s"] / r["steps"] for r in rows]
+        import numpy as np
+
+        print(f"scaling slope: {np.polyfit(np.log(n), np.log(t), 1)[0]:.3f}")
+    sys.stdout.flush()
+    return 0
