@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.builder import _cross
 from ..model.model import CONTACT_DISSIPATED, DAMPING_DISSIPATED, EXTERNAL_WORK, VISCOUS_ABSORBED
 
 
@@ -59,6 +60,3 @@ def budget_error(e: dict[str, float], initial_stored: float) -> tuple[float, flo
     scale = max(abs(e["external_work"]) + abs(e.get("explosive_released", 0.0)), e["kinetic"] + e["strain"] + e["springs"], 1e-300)
     return err, err / scale
 
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]

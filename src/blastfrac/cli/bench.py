@@ -51,10 +51,6 @@ def run(args) -> int:
         print("| particles | steps | wall [s] | particle-steps/s |")
         for r in rows:
             print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['particle_steps_per_s']:.3e} |")
-        n = [r["n_particles"] for r in rows]
-        t = [r["wall_s"] / r["steps"] for r in rows]
-        import numpy as np
-
-        print(f"scaling slope: {np.polyfit(np.log(n), np.log(t), 1)[0]:.3f}")
+        print(f"scaling slope: {_load('bench_cdem').scaling_slope(rows, 'n_particles'):.3f}")
     sys.stdout.flush()
     return 0
