@@ -16,11 +16,11 @@ import warp as wp
 
 from . import __version__
 from ._warp import resolve_device
-from .analysis.energy import budget_error, rock_energies
+from .analysis.energy import budget_error, gas_energies, rock_energies
 from .analysis.fracture import FractureDegree
 from .analysis.monitors import MonitorSet
 from .cdem.solver import CDEMSolver
-from .io.paraview import ParaviewSeries, crack_segments
+from .io.paraview import GasSeries, ParaviewSeries, crack_segments
 from .io.tables import CsvHistory, write_summary
 from .model.builder import ModelBuilder
 from .scenario.load import write_resolved
@@ -34,13 +34,6 @@ class SimulationError(RuntimeError):
 class Simulation:
     def __init__(self, scenario: Scenario, out_dir: str | Path | None = None, device: str | None = None,
                  max_steps: int | None = None, mesh=None):
-        if scenario.explosive is not None:
-            from .scenario.errors import ScenarioError
-
-            raise ScenarioError(
-                "[explosive] is validated (see `blastfrac check`, `blastfrac explosive`) but the gas–rock coupling "
-                "is not implemented yet; load the borehole with [[borehole_pressure]] for now"
-            )
         self.scenario = scenario
         self.device = resolve_device(device or scenario.simulation.device)
         self.out_dir = Path(out_dir or scenario.output.directory)
@@ -52,7 +45,12 @@ class Simulation:
         # first contact (tests/verification/test_block_contact.py, xfail). Broken springs still act as
         # unilateral frictional contacts until they separate.
         self.cdem = CDEMSolver(self.model, block_contact=False)
-        self.dt = scenario.simulation.dt_safety * self.model.stable_dt
+        self.gas = None
+        self.coupler = None
+        self.gas_report: dict = {}
+        if scenario.explosive is not None:
+            self._build_explosive()
+        self.dt = self._time_step()
         self.time = 0.0
         self.steps = 0
         self.alpha = scenario.simulation.damping
@@ -62,14 +60,70 @@ class Simulation:
         self.insitu_report: dict | None = None
         self.initial_stored = 0.0
 
+    # ------------------------------------------------------------------ explosive and coupling
+    def _build_explosive(self) -> None:
+        """MPM products on a grid covering the rock (default) and the particle–edge coupler (METHOD §3)."""
+        from .coupling import GasRockCoupler, clear_from_rock, default_contact_stiffness
+        from .explosives.library import cj_report
+        from .mpm.solver import MPMSolver
+        from .scenario.errors import ScenarioError
+
+        sc = self.scenario
+        ex = sc.explosive
+        if ex.grid.bounds is None and ex.grid.margin is None:
+            X = self.model.host["node_X"]
+            lo, hi = X.min(axis=0), X.max(axis=0)
+            ex = ex.model_copy(update={"grid": ex.grid.model_copy(update={"bounds": (tuple(lo), tuple(hi))})})
+        cp = sc.coupling
+        spacing = ex.grid.cell_size / ex.grid.points_per_cell
+        clearance = cp.wall_clearance * 0.5 * spacing
+        removed = [0]
+
+        def keep_clear(x, vol):
+            x2, vol2, removed[0] = clear_from_rock(x, vol, self.model, clearance)
+            return x2, vol2
+
+        self.gas = MPMSolver(ex, device=self.device, particle_filter=keep_clear)
+        if self.gas.n == 0:
+            raise ScenarioError("explosive.charges: no material point left after clearing the rock; the charges must "
+                                "lie in boreholes or outside the rock, at least one particle spacing wide")
+        cj = cj_report(self.gas.material, ex.name or "custom")
+        kc = cp.contact_stiffness or default_contact_stiffness(self.gas.p_cj, sc.rock.plane_strain_modulus,
+                                                               cp.stiffness_factor)
+        self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval)
+        self.gas_report = {
+            "particles": self.gas.n, "removed_at_seeding": removed[0], "grid_nodes": self.gas.spec.node_count,
+            "cell_size": self.gas.spec.h, "contact_stiffness": kc, "contact_dt": self.coupler.stable_dt(),
+            "cj_check": cj,
+        }
+
+    def _time_step(self) -> float:
+        """min(safety·Δt_rock, safety·Δt_contact, Δt_MPM) [s]; the MPM CFL factor is its own safety."""
+        safety = self.scenario.simulation.dt_safety
+        dt = safety * self.model.stable_dt
+        if self.gas is not None:
+            dt = min(dt, safety * self.coupler.stable_dt(), self.gas.stable_dt())
+        return dt
+
     # ------------------------------------------------------------------ one step
-    def step(self) -> None:
-        """Advance the rock by one explicit step (the MPM and coupling stages join in later issues)."""
+    def step(self, gas: bool = True) -> None:
+        """Advance rock (and gas) by one explicit step (METHOD §3.1); ``gas=False`` freezes the explosive."""
         dt = self.dt
-        self.cdem.forces(self.state, dt, self.time)        # 3. springs + failure, CST, loads, block contact
-        self.cdem.integrate(self.state, dt, self.alpha)    # 4. central difference on rock nodes
+        st = self.state
+        couple = gas and self.gas is not None
+        self.cdem.forces(st, dt, self.time)                # springs + failure, CST, loads, block contact
+        if couple:
+            self.coupler.apply(st, dt)                     # particle–edge contact: gas f_ext_p, rock reactions
+            self.gas.to_grid(dt)                           # P2G with the contact forces
+            self.gas.update_grid(dt)
+        self.cdem.integrate(st, dt, self.alpha)            # central difference on rock nodes
+        if couple:
+            self.gas.to_particles(dt)                      # G2P, MUSL remap, particle motion
+            self.gas.update_eos(dt, self.time)             # burn, viscosity, JWL
         self.time += dt
         self.steps += 1
+        if couple and self.steps % 10 == 0:
+            self.dt = self._time_step()
         if self.cdem.contact is not None and not self.cdem.contact.active and self.steps % 16 == 0:
             self.cdem.contact.active = bool(np.any(self.state.pair_dropped.numpy()))
 
@@ -88,7 +142,7 @@ class Simulation:
         min_steps = int(2 * span / self.scenario.rock.p_wave_speed / self.dt) + 1
         task = progress.add_task("in-situ relaxation", total=ins.max_steps) if progress else None
         while not converged and steps < ins.max_steps:
-            self.step()
+            self.step(gas=False)
             steps += 1
             if steps % 200 == 0:
                 e = rock_energies(self.model, self.state)
@@ -128,36 +182,57 @@ class Simulation:
         end = sc.simulation.end_time
         frame_dt = sc.output.interval or end / 20
         sample_dt = sc.output.monitor_interval or end / 200
-        n_total = math.ceil(end / self.dt)
-        if self.max_steps is not None:
-            n_total = min(n_total, self.max_steps)
+        snap_times = list(sc.output.snapshot_times) or [end * k / 4 for k in (1, 2, 3, 4)]
+        self.snapshots: list[dict] = []
         series = ParaviewSeries(self.out_dir) if sc.output.paraview else None
+        gas_series = GasSeries(self.out_dir) if sc.output.paraview and self.gas is not None else None
         mon = CsvHistory(self.out_dir / "monitors.csv", self.monitors.columns)
         frac = CsvHistory(self.out_dir / "fracture_degree.csv", list(self.fracture.sample(self.state.pair_mode.numpy())))
         energy_cols = ["kinetic", "strain", "springs", "fracture", "friction", "viscous_absorbed", "damping",
-                       "external_work", "budget_error"]
-        energy = CsvHistory(self.out_dir / "energy.csv", energy_cols)
+                       "external_work"]
+        if self.gas is not None:
+            energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_stored", "contact_dissipated"]
+        energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"])
         wall0 = _time.perf_counter()
         with _progress(show) as bar:
             if sc.insitu.active:
                 self.relax_insitu(bar)
-            task = bar.add_task("dynamic stage", total=n_total) if bar else None
-            next_frame, next_sample = 0.0, 0.0
-            while self.steps < n_total:
+            n_est = math.ceil(end / self.dt)
+            if self.max_steps is not None:
+                n_est = min(n_est, self.max_steps)
+            task = bar.add_task("dynamic stage", total=n_est) if bar else None
+            next_frame, next_sample, k_snap = 0.0, 0.0, 0
+            while self.time < end * (1 - 1e-12) and (self.max_steps is None or self.steps < self.max_steps):
                 if self.time >= next_sample - 1e-15:
                     self._sample(mon, frac, energy)
                     next_sample += sample_dt
-                if series is not None and self.time >= next_frame - 1e-15:
-                    series.write(self.model, self.state, self.time)
+                if self.time >= next_frame - 1e-15:
+                    if series is not None:
+                        series.write(self.model, self.state, self.time)
+                    if gas_series is not None:
+                        gas_series.write(self.gas, self.time)
                     next_frame += frame_dt
+                if k_snap < len(snap_times) and self.time >= snap_times[k_snap] - 0.5 * self.dt:
+                    self._snapshot()
+                    k_snap += 1
                 self.step()
-                if task is not None and (self.steps % 50 == 0 or self.steps == n_total):
-                    bar.update(task, completed=self.steps,
+                if task is not None and self.steps % 50 == 0:
+                    if self.gas is not None:   # the step may change with the gas speed: re-estimate the total
+                        n_est = self.steps + math.ceil(max(end - self.time, 0.0) / self.dt)
+                        if self.max_steps is not None:
+                            n_est = min(n_est, self.max_steps)
+                    bar.update(task, completed=self.steps, total=n_est,
                                description=f"dynamic stage t = {self.time * 1e6:8.2f} µs")
             wp.synchronize()
+            if task is not None:
+                bar.update(task, completed=self.steps, total=self.steps)
             self._sample(mon, frac, energy)
             if series is not None:
                 series.write(self.model, self.state, self.time)
+            if gas_series is not None:
+                gas_series.write(self.gas, self.time)
+            if k_snap < len(snap_times) or not self.snapshots:
+                self._snapshot()
         wall = _time.perf_counter() - wall0
         for h in (mon, frac, energy):
             h.flush()
@@ -167,15 +242,36 @@ class Simulation:
             self.write_figures(mon, frac, energy)
         return summary
 
+    def energies(self) -> dict[str, float]:
+        """All energy terms of rock, gas and contact [J/m] (see analysis.energy)."""
+        e = rock_energies(self.model, self.state)
+        if self.gas is not None:
+            e.update(gas_energies(self.gas))
+            c = self.coupler.energies()
+            e["contact_stored"], e["contact_dissipated"] = c["contact_stored"], c["contact_dissipated"]
+        return e
+
+    def _gas_pressure(self, pts: np.ndarray) -> np.ndarray:
+        return self.gas.pressure_at(pts)
+
     def _sample(self, mon: CsvHistory, frac: CsvHistory, energy: CsvHistory) -> None:
         st = self.state
         x, v, sig = st.x.numpy(), st.v.numpy(), st.sigma.numpy()
-        mon.append(self.time, self.monitors.sample(x, self.model.host["node_X"], v, sig))
+        gp = self._gas_pressure if self.gas is not None else None
+        mon.append(self.time, self.monitors.sample(x, self.model.host["node_X"], v, sig, gas_pressure=gp))
         frac.append(self.time, self.fracture.sample(st.pair_mode.numpy()).values())
-        e = rock_energies(self.model, st)
+        e = self.energies()
         self._guard(e)
         err, _ = budget_error(e, self.initial_stored)
         energy.append(self.time, [*(e[k] for k in energy.columns[1:-1]), err])
+
+    def _snapshot(self) -> None:
+        x = self.state.x.numpy().copy()
+        snap = {"time": self.time, "x": x, "u": x - self.model.host["node_X"]}
+        if self.gas is not None:
+            f = self.gas.particle_fields()
+            snap["gas_x"], snap["gas_p"] = f["position"], f["pressure"]
+        self.snapshots.append(snap)
 
     def _guard(self, e: dict) -> None:
         if not all(math.isfinite(v) for v in e.values()):
@@ -188,15 +284,16 @@ class Simulation:
     def summary(self, wall: float) -> dict:
         m, st = self.model, self.state
         mode = st.pair_mode.numpy()
-        e = rock_energies(m, st)
+        e = self.energies()
         err, rel = budget_error(e, self.initial_stored)
         counts = self.fracture.counts(mode)
-        return {
+        out = {
             "blastfrac_version": __version__,
             "title": self.scenario.title,
             "device": self.device,
             "counts": {"elements": m.element_count, "nodes": m.node_count, "springs": m.spring_count,
-                       "interfaces": m.interface_count, "loaded_edges": m.loaded_edge_count},
+                       "interfaces": m.interface_count, "loaded_edges": m.loaded_edge_count,
+                       "particles": self.gas.n if self.gas is not None else 0},
             "time_step": self.dt,
             "stable_time_step": m.stable_dt,
             "steps": self.steps,
@@ -208,7 +305,26 @@ class Simulation:
             "fracture_degree": self.fracture.sample(mode),
             "energy": {**e, "initial_stored": self.initial_stored, "budget_error": err, "budget_error_relative": rel},
             "insitu_stage": self.insitu_report,
+            "cracks": self.crack_statistics(),
         }
+        if self.gas is not None:
+            out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
+                                "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}
+        return out
+
+    def crack_statistics(self) -> list[dict]:
+        """Crushed-zone radius, radial crack count and lengths around each borehole (analysis.cracks)."""
+        from .analysis.cracks import crack_statistics
+
+        centres = [(b.center, b.radius) for b in self.scenario.geometry.boreholes]
+        if not centres and self.scenario.explosive is not None:
+            from .mpm.seeding import charge_area_centroid, charge_bbox
+
+            for c in self.scenario.explosive.charges:
+                lo, hi = charge_bbox(c)
+                centres.append((tuple(charge_area_centroid(c)[1]), 0.5 * float(np.min(hi - lo))))
+        mode = self.state.pair_mode.numpy()
+        return [crack_statistics(self.model, mode, np.asarray(c, float), r) for c, r in centres]
 
     def write_figures(self, mon: CsvHistory, frac: CsvHistory, energy: CsvHistory) -> None:
         from .plot import figures
@@ -222,18 +338,25 @@ class Simulation:
                                  show_mesh=self.model.element_count <= 60_000, circles=circles)
         figures.displacement_map(self.out_dir / "displacement.png", x, x - self.model.host["node_X"],
                                  title=f"{title}: |u| at t = {self.time * 1e6:.1f} µs")
+        if self.snapshots:
+            figures.displacement_snapshots(self.out_dir / "displacement_snapshots.png", self.snapshots,
+                                           title=f"{title}: displacement magnitude")
+        if self.gas is not None:
+            f = self.gas.particle_fields()
+            figures.gas_particles(self.out_dir / "gas_pressure.png", f["position"], f["pressure"], x, seg, cmode,
+                                  title=f"{title}: gas pressure at t = {self.time * 1e6:.1f} µs")
         t = np.array([r[0] for r in frac.rows])
-        figures.histories(self.out_dir / "fracture_degree.png", t,
-                          {k: frac.column(k) for k in frac.columns[1:] if not k.endswith("D_global")},
-                          "fracture degree [-]", "Fracture degree")
+        figures.fracture_degree_zones(self.out_dir / "fracture_degree.png", t,
+                                      {k: frac.column(k) for k in frac.columns[1:]}, title=f"{title}: fracture degree")
         figures.histories(self.out_dir / "energy.png", t, {k: energy.column(k) for k in energy.columns[1:]},
                           "energy [J/m]", "Energy budget")
         if mon.columns[1:]:
             tm = np.array([r[0] for r in mon.rows])
-            stress = {k: mon.column(k) for k in mon.columns[1:] if k.split(":")[1] in ("sxx", "syy", "sxy", "pressure")}
+            stress = {k: mon.column(k) for k in mon.columns[1:]
+                      if k.split(":")[1] in ("sxx", "syy", "sxy", "pressure", "gas_pressure")}
             if stress:
                 figures.histories(self.out_dir / "monitors_stress.png", tm, stress, "stress [MPa]",
-                                  "Monitor stresses (tension +)", yscale=1e-6)
+                                  "Monitor stresses (tension +) and pressures (compression +)", yscale=1e-6)
             vel = {k: mon.column(k) for k in mon.columns[1:] if k.split(":")[1] in ("vx", "vy", "speed")}
             if vel:
                 figures.histories(self.out_dir / "monitors_velocity.png", tm, vel, "velocity [m/s]", "Monitor velocities")

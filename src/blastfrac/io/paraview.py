@@ -67,3 +67,26 @@ class ParaviewSeries:
             '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
             f"{rows}\n  </Collection>\n</VTKFile>\n"
         )
+
+
+class GasSeries(ParaviewSeries):
+    """ParaView series of the gas particles (vertex cells): velocity, pressure, density, burn fraction."""
+
+    def __init__(self, directory: Path, name: str = "gas"):
+        super().__init__(directory, name)
+
+    def write(self, gas, t: float) -> None:  # type: ignore[override]
+        f = gas.particle_fields()
+        x = f["position"]
+        pts = np.c_[x, np.zeros(len(x))]
+        cells = [("vertex", np.arange(len(x)).reshape(-1, 1))] if len(x) else []
+        v = f["velocity"]
+        mesh = meshio.Mesh(
+            pts, cells,
+            point_data={"velocity": np.c_[v, np.zeros(len(v))], "pressure": f["pressure"], "density": f["density"],
+                        "burn_fraction": f["burn_fraction"], "relative_volume": f["relative_volume"]},
+        )
+        fname = f"{self.name}_{len(self.frames):04d}.vtu"
+        meshio.write(self.dir / fname, mesh, binary=True)
+        self.frames.append((t, fname))
+        self._write_pvd()

@@ -81,7 +81,9 @@ class MPMSolver:
     """
 
     # ------------------------------------------------------------------ construction
-    def __init__(self, config, device: str = "cpu"):
+    def __init__(self, config, device: str = "cpu", particle_filter=None):
+        """Seed the charges of ``config`` (an ExplosiveConfig); ``particle_filter(x, vol) -> (x, vol)``, if given,
+        edits the seeded points before lighting times are computed (e.g. to clear them from the rock)."""
         params: JWLParams = config.jwl()
         opts = MPMOptions(
             shape=config.shape,
@@ -98,6 +100,8 @@ class MPMSolver:
         )
         spec = grid_from_config(config)
         x, vol, _ = seed_charges(config.charges, spec, opts.ppc)
+        if particle_filter is not None:
+            x, vol = particle_filter(x, vol)
         if config.detonation_points:
             pts = np.array([d.position for d in config.detonation_points], float)
             delays = np.array([d.delay for d in config.detonation_points], float)

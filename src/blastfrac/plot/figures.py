@@ -85,3 +85,100 @@ def histories(path: Path, t: np.ndarray, series: dict[str, np.ndarray], ylabel: 
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def displacement_snapshots(path: Path, snapshots: list[dict], title: str = "") -> None:
+    """Displacement magnitude at several times side by side (paper Fig. 4 style), gas particles in grey."""
+    plt = _plt()
+    import matplotlib.tri as mtri
+    from matplotlib.colors import Normalize
+
+    n = len(snapshots)
+    fig, axes = plt.subplots(1, n, figsize=(3.6 * n + 0.8, 3.9), dpi=150, squeeze=False)
+    vmax = max(float(np.linalg.norm(s["u"], axis=1).max()) for s in snapshots) * 1e3 or 1.0
+    norm = Normalize(0.0, vmax)
+    pc = None
+    for ax, s in zip(axes[0], snapshots):
+        x = s["x"]
+        tri = np.arange(len(x)).reshape(-1, 3)
+        t = mtri.Triangulation(x[:, 0], x[:, 1], tri)
+        pc = ax.tripcolor(t, np.linalg.norm(s["u"], axis=1) * 1e3, shading="gouraud", cmap="viridis", norm=norm)
+        if "gas_x" in s and len(s["gas_x"]):
+            ax.scatter(s["gas_x"][:, 0], s["gas_x"][:, 1], s=0.2, c="0.6", linewidths=0)
+        ax.set_aspect("equal")
+        ax.set_xlim(x[:, 0].min(), x[:, 0].max())
+        ax.set_ylim(x[:, 1].min(), x[:, 1].max())
+        ax.set_title(f"t = {s['time'] * 1e6:.1f} µs", fontsize=9)
+        ax.tick_params(labelsize=7)
+    fig.colorbar(pc, ax=axes[0].tolist(), label="|u| [mm]", shrink=0.85)
+    fig.suptitle(title or "Displacement magnitude", fontsize=10)
+    fig.savefig(path, bbox_inches="tight")
+    plt.close(fig)
+
+
+def gas_particles(path: Path, xp: np.ndarray, p: np.ndarray, x: np.ndarray, seg: np.ndarray, mode: np.ndarray,
+                  title: str = "", zoom: float | None = None) -> None:
+    """Gas particles coloured by pressure over the cracked rock (cracks red tensile / blue shear)."""
+    plt = _plt()
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import LogNorm
+
+    fig, ax = plt.subplots(figsize=(7, 6), dpi=150)
+    for code, color in ((1, TENSILE_COLOR), (2, SHEAR_COLOR)):
+        s = seg[mode == code]
+        if len(s):
+            ax.add_collection(LineCollection(x[s], colors=color, linewidths=0.6))
+    if len(xp):
+        pp = np.maximum(p, 1e5) / 1e6
+        sc = ax.scatter(xp[:, 0], xp[:, 1], c=pp, s=1.5, cmap="inferno", norm=LogNorm(vmin=max(pp.min(), 0.1),
+                                                                                   vmax=max(pp.max(), 1.0)))
+        fig.colorbar(sc, ax=ax, label="gas pressure [MPa]")
+        c = xp.mean(axis=0)
+        span = zoom or max(4.0 * float(np.ptp(xp, axis=0).max()), 1e-3)
+        lo = np.maximum(c - span / 2, x.min(axis=0))
+        hi = np.minimum(c + span / 2, x.max(axis=0))
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(title or "Gas pressure")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def fracture_degree_zones(path: Path, t: np.ndarray, cols: dict[str, np.ndarray], title: str = "") -> None:
+    """Fracture degree over time: the whole model and one panel per zone, tensile and shear (Figs. 7, 11 style)."""
+    plt = _plt()
+    zones = []
+    for k in cols:
+        if ":" in k:
+            z = k.split(":")[0]
+            if z not in zones:
+                zones.append(z)
+    panels = ["model"] + zones
+    n = len(panels)
+    ncol = min(n, 4)
+    nrow = (n + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(3.3 * ncol, 2.7 * nrow), dpi=150, squeeze=False, sharex=True)
+    ts = np.asarray(t) * 1e6
+    for ax, name in zip(axes.flat, panels):
+        pre = "" if name == "model" else f"{name}:"
+        ax.plot(ts, cols[f"{pre}D_tensile"], color=TENSILE_COLOR, label="tensile")
+        ax.plot(ts, cols[f"{pre}D_shear"], color=SHEAR_COLOR, label="shear")
+        ax.plot(ts, cols[f"{pre}D"], color="k", lw=0.8, ls="--", label="total")
+        ax.set_title(name, fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.tick_params(labelsize=7)
+    for ax in axes.flat[n:]:
+        ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("time [µs]", fontsize=8)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("fracture degree [-]", fontsize=8)
+    axes.flat[0].legend(fontsize=7)
+    fig.suptitle(title or "Fracture degree", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)

@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from .explosive import ExplosiveConfig
 
@@ -54,8 +54,24 @@ class OutputConfig(_Strict):
     monitor_interval: float | None = Field(
         None, gt=0, description="Time between monitor/fracture-history samples [s]; default end_time/200."
     )
-    paraview: bool = Field(True, description="Write the ParaView (VTU + PVD) time series of the rock.")
+    paraview: bool = Field(
+        True, description="Write the ParaView (VTU + PVD) time series of the rock (and of the gas particles)."
+    )
     figures: bool = Field(True, description="Write PNG figures at the end of the run.")
+    snapshot_times: list[float] = Field(
+        default_factory=list,
+        description="Times [s] at which displacement (and gas) snapshots are kept for the Fig. 4-style panel; "
+        "default: four equally spaced times.",
+    )
+
+    @field_validator("snapshot_times")
+    @classmethod
+    def _snapshots(cls, v: list[float]) -> list[float]:
+        if any(t < 0 for t in v):
+            raise ValueError("snapshot times must be >= 0 s")
+        if len(v) > 12:
+            raise ValueError("at most 12 snapshot times")
+        return sorted(v)
 
 
 # --------------------------------------------------------------------------- rock
@@ -423,6 +439,32 @@ class RectangleZone(_Strict):
 Zone = Annotated[Union[AnnulusZone, SectorZone, RectangleZone], Field(discriminator="type")]
 
 
+# --------------------------------------------------------------------------- coupling
+class CouplingConfig(_Strict):
+    """Gas–rock particle–edge contact (METHOD §3); used when [explosive] is given."""
+
+    contact_stiffness: float | None = Field(
+        None, gt=0, description="Contact stiffness k_c [Pa] (force per unit thickness per metre of overlap); "
+        "default max(stiffness_factor·P_CJ, E').",
+    )
+    stiffness_factor: float = Field(
+        20.0, ge=1, le=1000, description="k_c/P_CJ when contact_stiffness is not given [-]; 20 keeps the overlap "
+        "below r_p/10 at the CJ pressure.",
+    )
+    damping_ratio: float = Field(
+        0.0, ge=0, le=1, description="Normal contact dashpot as a fraction of critical [-]. Off by default: its "
+        "force reaches a particle through the grid, so the energy it removes is only estimated (energy.csv).",
+    )
+    friction: float = Field(0.0, ge=0, le=2, description="Gas–rock friction coefficient [-]; 0 for an inviscid gas.")
+    rebuild_interval: int = Field(
+        5, ge=1, le=100, description="Steps between rebuilds of the exposed-edge search structure [-]."
+    )
+    wall_clearance: float = Field(
+        1.0, ge=0, le=3, description="Seeded particles closer than this many particle radii to a rock edge are "
+        "removed (the charge's area is kept by scaling the others) [-].",
+    )
+
+
 # --------------------------------------------------------------------------- scenario
 class Scenario(_Strict):
     """A complete blastfrac run."""
@@ -444,6 +486,7 @@ class Scenario(_Strict):
     explosive: ExplosiveConfig | None = Field(
         None, description="MPM explosive (JWL products, programmed burn); see blastfrac.scenario.explosive."
     )
+    coupling: CouplingConfig = Field(default_factory=CouplingConfig)
 
     @model_validator(mode="after")
     def _cross_checks(self) -> "Scenario":

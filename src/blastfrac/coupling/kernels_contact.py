@@ -1,0 +1,133 @@
+"""Warp kernels of the gas–rock coupling: exposed-element collection and particle–edge contact forces."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from .particle_edge import contact_force, edge_overlap, vertex_overlap
+
+# slots of the coupling's energy accumulator
+ACC_DISSIPATED = 0     # energy dissipated by contact dashpots and friction since the start [J/m]
+ACC_STORED = 1         # penalty energy ½k_c·δ² stored in the contacts at this step [J/m]
+ACC_CONTACTS = 2       # number of particle–element contacts at this step [-]
+
+
+@wp.func
+def slot_exposed(s: wp.int32, slot_iface: wp.array(dtype=wp.int32), pair_mode: wp.array(dtype=wp.int32)):
+    """Edge slot s is exposed when it is on the mesh boundary or both springs of its interface broke."""
+    q = slot_iface[s]
+    if q < 0:
+        return True
+    return pair_mode[2 * q] > 0 and pair_mode[2 * q + 1] > 0
+
+
+@wp.kernel
+def collect_exposed_elements(
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    elem_reach: wp.array(dtype=wp.float64),
+    count: wp.array(dtype=wp.int32),
+    elems: wp.array(dtype=wp.int32),
+    points: wp.array(dtype=wp.vec3d),
+    reach_max: wp.array(dtype=wp.float64),
+):
+    """Compact list of elements with an exposed edge, their centroids (z = 0) and the largest reach [m]."""
+    e = wp.tid()
+    s = 3 * e
+    if not (slot_exposed(s, slot_iface, pair_mode) or slot_exposed(s + 1, slot_iface, pair_mode)
+            or slot_exposed(s + 2, slot_iface, pair_mode)):
+        return
+    k = wp.atomic_add(count, 0, 1)
+    c = (x[s] + x[s + 1] + x[s + 2]) / wp.float64(3.0)
+    elems[k] = e
+    points[k] = wp.vec3d(c[0], c[1], wp.float64(0.0))
+    wp.atomic_max(reach_max, 0, elem_reach[e])
+
+
+@wp.kernel
+def eval_particle_edge_contact(
+    grid: wp.uint64,
+    elems: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x_rock: wp.array(dtype=wp.vec2d),
+    v_rock: wp.array(dtype=wp.vec2d),
+    m_rock: wp.array(dtype=wp.float64),
+    x_p: wp.array(dtype=wp.vec2d),
+    v_p: wp.array(dtype=wp.vec2d),
+    m_p: wp.array(dtype=wp.float64),
+    vol_p: wp.array(dtype=wp.float64),
+    active: wp.array(dtype=wp.int32),
+    kc: wp.float64,
+    zeta: wp.float64,
+    mu: wp.float64,
+    r_max: wp.float64,
+    query_radius: wp.float64,
+    dt: wp.float64,
+    f_p: wp.array(dtype=wp.vec2d),
+    f_rock: wp.array(dtype=wp.vec2d),
+    acc: wp.array(dtype=wp.float64),
+):
+    """Contact force on each particle (assigned to f_p) and its reactions (added to f_rock), METHOD §3."""
+    p = wp.tid()
+    zero = wp.float64(0.0)
+    one = wp.float64(1.0)
+    fsum = wp.vec2d(zero, zero)
+    if active[p] == 0:
+        f_p[p] = fsum
+        return
+    xp = x_p[p]
+    vp = v_p[p]
+    mp = m_p[p]
+    rp = wp.min(wp.float64(0.5) * wp.sqrt(vol_p[p]), r_max)
+    diss = wp.float64(0.0)
+    stored = wp.float64(0.0)
+    ncon = int(0)
+    query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius)
+    idx = int(0)
+    while wp.hash_grid_query_next(query, idx):
+        e = elems[idx]
+        best = wp.float64(-1.0)
+        bn = wp.vec2d(zero, zero)
+        ia = int(-1)
+        ib = int(-1)
+        bxi = wp.float64(0.0)
+        for k in range(3):
+            s = 3 * e + k
+            if slot_exposed(s, slot_iface, pair_mode):
+                b = 3 * e + (k + 1) % 3
+                de, ne, xie = edge_overlap(xp, rp, x_rock[s], x_rock[b])
+                if de > best:
+                    best = de
+                    bn = ne
+                    ia = s
+                    ib = b
+                    bxi = xie
+        for k in range(3):
+            a = 3 * e + k
+            if slot_exposed(a, slot_iface, pair_mode) or slot_exposed(3 * e + (k + 2) % 3, slot_iface, pair_mode):
+                dv, nv = vertex_overlap(xp, rp, x_rock[a])
+                if dv > best:
+                    best = dv
+                    bn = nv
+                    ia = a
+                    ib = a
+                    bxi = zero
+        if best > zero:
+            wa = one - bxi
+            mc = wa * m_rock[ia] + bxi * m_rock[ib]
+            vc = wa * v_rock[ia] + bxi * v_rock[ib]
+            cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
+            f, pw = contact_force(best, bn, vp - vc, kc, cn, mu)
+            fsum = fsum + f
+            wp.atomic_add(f_rock, ia, -wa * f)
+            wp.atomic_add(f_rock, ib, -bxi * f)
+            diss = diss + pw * dt
+            stored = stored + wp.float64(0.5) * kc * best * best
+            ncon = ncon + 1
+    f_p[p] = fsum
+    if ncon > 0:
+        wp.atomic_add(acc, 0, diss)
+        wp.atomic_add(acc, 1, stored)
+        wp.atomic_add(acc, 2, wp.float64(ncon))

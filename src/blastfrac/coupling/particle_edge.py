@@ -1,0 +1,116 @@
+"""Particle–edge contact law between MPM gas particles and exposed CDEM block edges (METHOD §3, Y27–Y30).
+
+A material point is a disk of radius r_p [m]. For one element, every *exposed* edge (on the mesh
+boundary, on a borehole wall, or an interface whose two springs have both broken) and every vertex of
+an exposed edge is a candidate:
+
+* edge a→b (outward unit normal n̂ = (t_y, −t_x) for counter-clockwise triangles, t̂ = (x_b − x_a)/L):
+  ξ = (x_p − x_a)·t̂/L, d = (x_p − x_a)·n̂; contact if 0 ≤ ξ ≤ 1 and −r_p < d < r_p, overlap δ = r_p − d;
+  the guard d > −r_p keeps a particle from being caught by an edge from inside the rock (Y27);
+* vertex a: contact if |x_p − x_a| < r_p, δ = r_p − |x_p − x_a|, normal along x_p − x_a. Vertices close
+  convex corners (crack mouths, fragment corners) through which a particle could otherwise slip.
+
+Only the candidate with the largest overlap counts per (particle, element), so a particle near an
+element corner is not pushed twice by the same block.
+
+Force on the particle (per unit thickness) [N/m]:
+  F_n = max(k_c·δ − c_n·v_n, 0) along n̂ (total penalty form, Y28, with a normal dashpot
+  c_n = 2ζ√(m_eff·k_c), m_eff = m_p·m_c/(m_p + m_c), v_n = (v_p − v_c)·n̂);
+  F_t = −min(μ·F_n, c_n·|v_t|)·v_t/|v_t| (Coulomb friction with viscous regularisation instead of the
+  incremental history of Y29; μ = 0 by default: an inviscid gas).
+The reaction −f goes to the edge nodes with weights (1 − ξ, ξ) (linear interpolation; see the note on Y30
+in METHOD §3), so momentum is conserved exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import warp as wp
+
+NO_CONTACT = -1.0
+
+
+@wp.func
+def edge_overlap(xp: wp.vec2d, rp: wp.float64, xa: wp.vec2d, xb: wp.vec2d):
+    """(δ [m], n̂, ξ) of a disk at xp with radius rp against edge a→b; δ = −1 when not in contact."""
+    d = xb - xa
+    L = wp.length(d)
+    t = d / L
+    n = wp.vec2d(t[1], -t[0])
+    r = xp - xa
+    xi = wp.dot(r, t) / L
+    g = wp.dot(r, n)
+    delta = wp.float64(NO_CONTACT)
+    if xi >= wp.float64(0.0) and xi <= wp.float64(1.0) and g > -rp and g < rp:
+        delta = rp - g
+    return delta, n, xi
+
+
+@wp.func
+def vertex_overlap(xp: wp.vec2d, rp: wp.float64, xa: wp.vec2d):
+    """(δ [m], n̂) of a disk at xp with radius rp against the vertex xa; δ = −1 when not in contact."""
+    r = xp - xa
+    dist = wp.length(r)
+    delta = wp.float64(NO_CONTACT)
+    n = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
+    if dist < rp and dist > wp.float64(1e-12) * rp:
+        delta = rp - dist
+        n = r / dist
+    return delta, n
+
+
+@wp.func
+def contact_force(delta: wp.float64, n: wp.vec2d, vrel: wp.vec2d, kc: wp.float64, cn: wp.float64, mu: wp.float64):
+    """Force on the particle [N/m] and the power it dissipates [W/m] for overlap δ and relative velocity vrel."""
+    vn = wp.dot(vrel, n)
+    fn_el = kc * delta
+    fn = wp.max(fn_el - cn * vn, wp.float64(0.0))
+    diss = -(fn - fn_el) * vn
+    vt = vrel - vn * n
+    svt = wp.length(vt)
+    f = fn * n
+    if mu > wp.float64(0.0) and svt > wp.float64(0.0):
+        ft = wp.min(mu * fn, cn * svt)
+        f = f - ft * vt / svt
+        diss = diss + ft * svt
+    return f, diss
+
+
+# ---------------------------------------------------------------------------------------------- NumPy twins
+def edge_overlap_np(xp, rp, xa, xb):
+    """NumPy twin of :func:`edge_overlap`; returns (δ, n̂, ξ)."""
+    xp, xa, xb = (np.asarray(a, float) for a in (xp, xa, xb))
+    d = xb - xa
+    L = np.linalg.norm(d)
+    t = d / L
+    n = np.array([t[1], -t[0]])
+    r = xp - xa
+    xi, g = r @ t / L, r @ n
+    delta = rp - g if (0.0 <= xi <= 1.0 and -rp < g < rp) else NO_CONTACT
+    return delta, n, xi
+
+
+def vertex_overlap_np(xp, rp, xa):
+    """NumPy twin of :func:`vertex_overlap`; returns (δ, n̂)."""
+    r = np.asarray(xp, float) - np.asarray(xa, float)
+    dist = np.linalg.norm(r)
+    if rp > dist > 1e-12 * rp:
+        return rp - dist, r / dist
+    return NO_CONTACT, np.zeros(2)
+
+
+def contact_force_np(delta, n, vrel, kc, cn, mu):
+    """NumPy twin of :func:`contact_force`; returns (f [N/m], dissipated power [W/m])."""
+    n, vrel = np.asarray(n, float), np.asarray(vrel, float)
+    vn = vrel @ n
+    fn_el = kc * delta
+    fn = max(fn_el - cn * vn, 0.0)
+    diss = -(fn - fn_el) * vn
+    vt = vrel - vn * n
+    svt = np.linalg.norm(vt)
+    f = fn * n
+    if mu > 0 and svt > 0:
+        ft = min(mu * fn, cn * svt)
+        f = f - ft * vt / svt
+        diss += ft * svt
+    return f, diss
