@@ -88,9 +88,9 @@ class Simulation:
             raise ScenarioError("explosive.charges: no material point left after clearing the rock; the charges must "
                                 "lie in boreholes or outside the rock, at least one particle spacing wide")
         cj = cj_report(self.gas.material, ex.name or "custom")
-        kc = cp.contact_stiffness or default_contact_stiffness(self.gas.p_cj, sc.rock.plane_strain_modulus,
-                                                               cp.stiffness_factor)
-        self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval)
+        kc = cp.contact_stiffness or default_contact_stiffness(self.gas.p_cj, cp.stiffness_factor)
+        self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval,
+                                      force_cap=cp.force_cap)
         self.gas_report = {
             "particles": self.gas.n, "removed_at_seeding": removed[0], "grid_nodes": self.gas.spec.node_count,
             "cell_size": self.gas.spec.h, "contact_stiffness": kc, "contact_dt": self.coupler.stable_dt(),
@@ -191,7 +191,7 @@ class Simulation:
         energy_cols = ["kinetic", "strain", "springs", "fracture", "friction", "viscous_absorbed", "damping",
                        "external_work"]
         if self.gas is not None:
-            energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_stored", "contact_dissipated"]
+            energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_energy"]
         energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"])
         wall0 = _time.perf_counter()
         with _progress(show) as bar:
@@ -248,7 +248,7 @@ class Simulation:
         if self.gas is not None:
             e.update(gas_energies(self.gas))
             c = self.coupler.energies()
-            e["contact_stored"], e["contact_dissipated"] = c["contact_stored"], c["contact_dissipated"]
+            e["contact_energy"] = c["contact_energy"]
         return e
 
     def _gas_pressure(self, pts: np.ndarray) -> np.ndarray:

@@ -74,7 +74,7 @@ def gas_energies(gas) -> dict[str, float]:
 
 # the terms that hold or have taken energy; the supplied side is initial stored + external work + explosive
 HELD_TERMS = ("kinetic", "strain", "springs", "fracture", "friction", "viscous_absorbed", "damping",
-              "gas_kinetic", "gas_internal", "contact_stored", "contact_dissipated")
+              "gas_kinetic", "gas_internal", "contact_energy")
 
 
 def budget_error(e: dict[str, float], initial_stored: float) -> tuple[float, float]:

@@ -14,24 +14,26 @@ import math
 import numpy as np
 import warp as wp
 
-from .kernels_contact import ACC_CONTACTS, ACC_DISSIPATED, ACC_STORED, collect_exposed_elements, eval_particle_edge_contact
+from .kernels_contact import ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, collect_exposed_elements, eval_particle_edge_contact
 
 
-def default_contact_stiffness(p_cj: float, plane_strain_modulus: float, factor: float = 20.0) -> float:
-    """k_c = max(factor·P_CJ, E′) [Pa] (METHOD §3.5: overlap ≤ r_p/10 at the CJ pressure when factor = 20)."""
-    return max(factor * p_cj, plane_strain_modulus)
+def default_contact_stiffness(p_cj: float, factor: float = 20.0) -> float:
+    """k_c = factor·P_CJ [Pa]: the overlap at pressure p is about 2p/k_c·r_p (r_p/10 at P_CJ for factor 20)."""
+    return factor * p_cj
 
 
 class GasRockCoupler:
     """Particle–edge contact between ``mpm`` (an MPMSolver) and the rock ``model``; buffers allocated once.
 
     kc: contact stiffness [Pa = N/m per m of overlap, per unit thickness]; zeta: dashpot damping ratio [-];
-    mu: friction coefficient [-]; r_max: cap on the particle radius r_p = ½√V_p [m].
+    mu: friction coefficient [-]; r_max: cap on the particle radius r_p = ½√V_p [m]; force_cap: κ of the
+    pressure-based cap on the normal force (0: none), see :func:`particle_edge.normal_force_cap`.
     """
 
-    def __init__(self, model, mpm, kc: float, zeta: float = 0.1, mu: float = 0.0, rebuild_interval: int = 5,
-                 r_max: float | None = None):
+    def __init__(self, model, mpm, kc: float, zeta: float = 0.0, mu: float = 0.0, rebuild_interval: int = 5,
+                 r_max: float | None = None, force_cap: float = 2.0):
         self.model, self.mpm = model, mpm
+        self.force_cap = float(force_cap)
         self.kc, self.zeta, self.mu = float(kc), float(zeta), float(mu)
         self.rebuild_interval = int(rebuild_interval)
         d = model.device
@@ -96,15 +98,17 @@ class GasRockCoupler:
             return
         wp.launch(eval_particle_edge_contact, dim=mpm.n,
                   inputs=[self.grid.id, self.elems, self.slot_iface, state.pair_mode, state.x, state.v, m.node_mass,
-                          mpm.x, mpm.v_pic, mpm.mass, mpm.vol, mpm.active,
-                          wp.float64(self.kc), wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
+                          mpm.x, mpm.v_pic, mpm.mass, mpm.vol, mpm.p, mpm.rho, mpm.active,
+                          wp.float64(self.kc), wp.float64(self.force_cap), wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
                           wp.float64(self.query_radius), wp.float64(dt)],
                   outputs=[mpm.f_ext_p, state.f, self.acc], device=m.device)
 
     def energies(self) -> dict[str, float]:
-        """contact_stored (½k_c·δ² now) and contact_dissipated (dashpots and friction so far) [J/m]; contacts [-]."""
+        """contact_energy: work absorbed by the contacts so far, ∫ −f·(v_p − v_c) dt [J/m] (penalty energy held
+        now plus dashpot, friction and force-cap losses); contact_penalty: ½k_c·δ² now (uncapped, for reference)
+        [J/m]; contacts: particle–element contacts now [-]."""
         a = self.acc.numpy()
-        return {"contact_stored": float(a[ACC_STORED]), "contact_dissipated": float(a[ACC_DISSIPATED]),
+        return {"contact_energy": float(a[ACC_ABSORBED]), "contact_penalty": float(a[ACC_STORED]),
                 "contacts": int(a[ACC_CONTACTS])}
 
 

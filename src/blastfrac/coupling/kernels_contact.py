@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import warp as wp
 
-from .particle_edge import contact_force, edge_overlap, vertex_overlap
+from .particle_edge import contact_force, edge_overlap, normal_force_cap, vertex_overlap
 
 # slots of the coupling's energy accumulator
-ACC_DISSIPATED = 0     # energy dissipated by contact dashpots and friction since the start [J/m]
+ACC_ABSORBED = 0       # work absorbed by the contacts since the start, ∫ −f·(v_p − v_c) dt [J/m]
 ACC_STORED = 1         # penalty energy ½k_c·δ² stored in the contacts at this step [J/m]
 ACC_CONTACTS = 2       # number of particle–element contacts at this step [-]
 
@@ -58,8 +58,11 @@ def eval_particle_edge_contact(
     v_p: wp.array(dtype=wp.vec2d),
     m_p: wp.array(dtype=wp.float64),
     vol_p: wp.array(dtype=wp.float64),
+    p_p: wp.array(dtype=wp.float64),
+    rho_p: wp.array(dtype=wp.float64),
     active: wp.array(dtype=wp.int32),
     kc: wp.float64,
+    kappa: wp.float64,
     zeta: wp.float64,
     mu: wp.float64,
     r_max: wp.float64,
@@ -119,11 +122,15 @@ def eval_particle_edge_contact(
             mc = wa * m_rock[ia] + bxi * m_rock[ib]
             vc = wa * v_rock[ia] + bxi * v_rock[ib]
             cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
-            f, pw = contact_force(best, bn, vp - vc, kc, cn, mu)
+            vrel = vp - vc
+            fcap = wp.float64(0.0)
+            if kappa > zero:
+                fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
+            f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
             fsum = fsum + f
             wp.atomic_add(f_rock, ia, -wa * f)
             wp.atomic_add(f_rock, ib, -bxi * f)
-            diss = diss + pw * dt
+            diss = diss - wp.dot(f, vrel) * dt
             stored = stored + wp.float64(0.5) * kc * best * best
             ncon = ncon + 1
     f_p[p] = fsum

@@ -14,7 +14,7 @@ Only the candidate with the largest overlap counts per (particle, element), so a
 element corner is not pushed twice by the same block.
 
 Force on the particle (per unit thickness) [N/m]:
-  F_n = max(k_c·δ − c_n·v_n, 0) along n̂ (total penalty form, Y28, with a normal dashpot
+  F_n = max(min(k_c·δ, F_cap) − c_n·v_n, 0) along n̂, F_cap = κ·(p + ρ·v_a²)·2r_p (see normal_force_cap) (total penalty form, Y28, with a normal dashpot
   c_n = 2ζ√(m_eff·k_c), m_eff = m_p·m_c/(m_p + m_c), v_n = (v_p − v_c)·n̂);
   F_t = −min(μ·F_n, c_n·|v_t|)·v_t/|v_t| (Coulomb friction with viscous regularisation instead of the
   incremental history of Y29; μ = 0 by default: an inviscid gas).
@@ -60,10 +60,16 @@ def vertex_overlap(xp: wp.vec2d, rp: wp.float64, xa: wp.vec2d):
 
 
 @wp.func
-def contact_force(delta: wp.float64, n: wp.vec2d, vrel: wp.vec2d, kc: wp.float64, cn: wp.float64, mu: wp.float64):
-    """Force on the particle [N/m] and the power it dissipates [W/m] for overlap δ and relative velocity vrel."""
+def contact_force(delta: wp.float64, n: wp.vec2d, vrel: wp.vec2d, kc: wp.float64, cn: wp.float64, mu: wp.float64,
+                  fcap: wp.float64):
+    """Force on the particle [N/m] and the power it dissipates [W/m] for overlap δ and relative velocity vrel.
+
+    The elastic normal force is capped at fcap [N/m] (no cap when fcap <= 0), see :func:`normal_force_cap`.
+    """
     vn = wp.dot(vrel, n)
     fn_el = kc * delta
+    if fcap > wp.float64(0.0):
+        fn_el = wp.min(fn_el, fcap)
     fn = wp.max(fn_el - cn * vn, wp.float64(0.0))
     diss = -(fn - fn_el) * vn
     vt = vrel - vn * n
@@ -74,6 +80,16 @@ def contact_force(delta: wp.float64, n: wp.vec2d, vrel: wp.vec2d, kc: wp.float64
         f = f - ft * vt / svt
         diss = diss + ft * svt
     return f, diss
+
+
+@wp.func
+def normal_force_cap(kappa: wp.float64, p: wp.float64, rho: wp.float64, vn: wp.float64, rp: wp.float64):
+    """κ·(p + ρ·v_a²)·2r_p [N/m]: the most a gas particle of pressure p [Pa], density ρ [kg/m³] approaching at
+    v_a = max(−v_n, 0) [m/s] may push on one contact. It holds a particle at rest against its pressure (needs
+    p·2r_p) and stops an approaching one within r_p/κ, while a particle squeezed into a crack narrower than
+    itself can no longer push its faces apart with the full penalty force k_c·δ (a disk is not a solid)."""
+    va = wp.max(-vn, wp.float64(0.0))
+    return kappa * (wp.max(p, wp.float64(0.0)) + rho * va * va) * wp.float64(2.0) * rp
 
 
 # ---------------------------------------------------------------------------------------------- NumPy twins
@@ -99,11 +115,19 @@ def vertex_overlap_np(xp, rp, xa):
     return NO_CONTACT, np.zeros(2)
 
 
-def contact_force_np(delta, n, vrel, kc, cn, mu):
+def normal_force_cap_np(kappa, p, rho, vn, rp):
+    """NumPy twin of :func:`normal_force_cap` [N/m]."""
+    va = max(-vn, 0.0)
+    return kappa * (max(p, 0.0) + rho * va * va) * 2.0 * rp
+
+
+def contact_force_np(delta, n, vrel, kc, cn, mu, fcap=0.0):
     """NumPy twin of :func:`contact_force`; returns (f [N/m], dissipated power [W/m])."""
     n, vrel = np.asarray(n, float), np.asarray(vrel, float)
     vn = vrel @ n
     fn_el = kc * delta
+    if fcap > 0:
+        fn_el = min(fn_el, fcap)
     fn = max(fn_el - cn * vn, 0.0)
     diss = -(fn - fn_el) * vn
     vt = vrel - vn * n

@@ -445,11 +445,17 @@ class CouplingConfig(_Strict):
 
     contact_stiffness: float | None = Field(
         None, gt=0, description="Contact stiffness k_c [Pa] (force per unit thickness per metre of overlap); "
-        "default max(stiffness_factor·P_CJ, E').",
+        "default stiffness_factor·P_CJ.",
     )
     stiffness_factor: float = Field(
-        20.0, ge=1, le=1000, description="k_c/P_CJ when contact_stiffness is not given [-]; 20 keeps the overlap "
-        "below r_p/10 at the CJ pressure.",
+        20.0, ge=1, le=1000, description="k_c/P_CJ when contact_stiffness is not given [-]; the overlap at pressure p "
+        "is about 2p/k_c·r_p, so 20 keeps it below r_p/10 at P_CJ.",
+    )
+    force_cap: float = Field(
+        2.0, ge=0, le=100, description="κ of the cap on each contact's normal force, κ·(p + ρ·v_a²)·2r_p with the "
+        "particle's pressure p, density ρ and approach speed v_a [-]; 0 switches the cap off. Without it, stiff "
+        "contacts chatter and load the wall with spikes of several times the gas pressure, and particles squeezed "
+        "into narrow cracks push the faces apart with the full penalty force.",
     )
     damping_ratio: float = Field(
         0.0, ge=0, le=1, description="Normal contact dashpot as a fraction of critical [-]. Off by default: its "
