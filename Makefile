@@ -2,7 +2,7 @@
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
-DEMO   := examples/borehole_pulse/scenario.toml
+DEMO   := examples/circular_rock/demo.toml
 
 .PHONY: demo test validate bench clean
 
@@ -19,15 +19,20 @@ $(VENV)/.installed-test: $(VENV)/.installed
 ## demo: create .venv, install, run the default scenario and write its figures to out/demo
 demo: $(VENV)/.installed
 	$(BIN)/blastfrac run $(DEMO) --out out/demo
-	@echo "figures: out/demo/fracture_pattern.png out/demo/displacement.png out/demo/*.png"
+	@echo "figures: out/demo/fracture_pattern.png out/demo/displacement_snapshots.png out/demo/gas_pressure.png out/demo/*.png"
 
 ## test: install the test extras and run the test suite (no slow tests)
 test: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q
 
-## validate: long verification and validation runs (not in CI)
+EXAMPLES := examples/circular_rock/scenario.toml examples/single_hole/scenario.toml \
+            examples/confined_blast/scenario_P0.toml examples/confined_blast/scenario_P15.toml \
+            examples/confined_blast/scenario_P30.toml
+
+## validate: long verification runs and the paper's examples at full resolution (not in CI)
 validate: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q -m slow
+	for s in $(EXAMPLES); do $(BIN)/blastfrac run $$s || exit 1; done
 
 ## bench: performance suite (throughput and scaling), results printed and appended to benchmarks/
 bench: $(VENV)/.installed

@@ -42,7 +42,7 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(title or "Fracture pattern")
+    ax.set_title(title or "Fracture pattern", fontsize=10)
     if len(seg):
         ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
@@ -142,7 +142,7 @@ def gas_particles(path: Path, xp: np.ndarray, p: np.ndarray, x: np.ndarray, seg:
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(title or "Gas pressure")
+    ax.set_title(title or "Gas pressure", fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
