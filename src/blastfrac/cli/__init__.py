@@ -12,7 +12,7 @@ import sys
 EXIT_USER_ERROR = 2
 
 # subcommand modules, each exposing add_parser(subparsers) and run(args) -> int
-_COMMANDS = ("run", "check", "bench", "explosive")
+_COMMANDS = ("run", "check", "bench", "explosive", "calibrate")
 
 
 def build_parser() -> argparse.ArgumentParser:

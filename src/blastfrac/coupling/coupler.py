@@ -31,7 +31,7 @@ class GasRockCoupler:
     """
 
     def __init__(self, model, mpm, kc: float, zeta: float = 0.0, mu: float = 0.0, rebuild_interval: int = 5,
-                 r_max: float | None = None, force_cap: float = 2.0):
+                 r_max: float | None = None, force_cap: float = 0.0):
         self.model, self.mpm = model, mpm
         self.force_cap = float(force_cap)
         self.kc, self.zeta, self.mu = float(kc), float(zeta), float(mu)

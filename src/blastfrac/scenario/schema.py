@@ -452,10 +452,9 @@ class CouplingConfig(_Strict):
         "is about 2p/k_c·r_p, so 20 keeps it below r_p/10 at P_CJ.",
     )
     force_cap: float = Field(
-        2.0, ge=0, le=100, description="κ of the cap on each contact's normal force, κ·(p + ρ·v_a²)·2r_p with the "
-        "particle's pressure p, density ρ and approach speed v_a [-]; 0 switches the cap off. Without it, stiff "
-        "contacts chatter and load the wall with spikes of several times the gas pressure, and particles squeezed "
-        "into narrow cracks push the faces apart with the full penalty force.",
+        0.0, ge=0, le=100, description="Experimental: κ of a cap on each contact's normal force, κ·(p + ρ·v_a²)·2r_p "
+        "with the particle's pressure p, density ρ and approach speed v_a [-]; 0 (default) = no cap. κ = 2 removes "
+        "the chatter spikes on the wall but lets particles leak through it (piston and leak tests fail).",
     )
     damping_ratio: float = Field(
         0.0, ge=0, le=1, description="Normal contact dashpot as a fraction of critical [-]. Off by default: its "
