@@ -57,10 +57,16 @@ class GasRockCoupler:
         self.query_radius = 0.0
         self.n_exposed = 0
         self._since = self.rebuild_interval
-        self.dissipated = 0.0
+        self._dt: float | None = None
 
     # ------------------------------------------------------------------ stable step
     def stable_dt(self) -> float:
+        """2/ω of the stiffest contact [s], computed once (masses and k_c do not change); see ``_contact_dt``."""
+        if self._dt is None:
+            self._dt = self._contact_dt()
+        return self._dt
+
+    def _contact_dt(self) -> float:
         """2/ω of the stiffest contact [s]: a particle held by two edges (2k_c/m_p) and a rock node loaded by
         the particles along its two element edges (k_c·(L₁ + L₂)/(2r_p)/m_node); METHOD §3.6."""
         m_p = float(self.mpm.mass.numpy().min()) if self.mpm.n else math.inf
