@@ -146,6 +146,8 @@ def test_pressure_floor():
 
 def test_cj_state_petn_handbook():
     cj = cj_state(PETN)
+    print(f"\n  PETN 1.77 CJ from its JWL Hugoniot: D = {cj.D:.1f} m/s ({cj.D / 8300 - 1:+.3%} vs handbook 8300), "
+          f"P = {cj.p / 1e9:.3f} GPa ({cj.p / 33.5e9 - 1:+.3%} vs 33.5), V = {cj.V:.4f}")
     assert abs(cj.D / 8300.0 - 1) < 0.005, cj.D
     assert abs(cj.p / 33.5e9 - 1) < 0.005, cj.p
     # tangency of the Rayleigh line and the Hugoniot at the CJ point
@@ -157,6 +159,12 @@ def test_cj_state_petn_handbook():
     C = isentrope_constant(PETN, cj.V, cj.E)
     dps = (isentrope_pressure_np(cj.V + dV, PETN, C) - isentrope_pressure_np(cj.V - dV, PETN, C)) / (2 * dV)
     assert abs(-cj.V / cj.p * dps / (cj.V / (1 - cj.V)) - 1) < 1e-5
+
+
+def test_cj_state_tnt_handbook():
+    """TNT 1.63 (same handbook): D = 6930 m/s, P_CJ = 21.0 GPa."""
+    cj = cj_state(get_explosive("tnt"))
+    assert abs(cj.D / 6930.0 - 1) < 0.005 and abs(cj.p / 21.0e9 - 1) < 0.01, (cj.D, cj.p)
 
 
 def test_cj_emulsion_flags_inconsistent_D():

@@ -5,18 +5,32 @@ rho0 [kg/m^3], D [m/s], A and B [Pa], R1, R2, omega [-], E0 [J/m^3].
 
 Sources
 -------
-``emulsion``  Yue, Zhou, Feng et al., Computers and Geotechnics 2022, 104629, Table 1
-              (who quote An et al., 2018).  Its own CJ state (D ~ 5.5 km/s) does not
-              match the quoted D = 4000 m/s; see VALIDATION.md §0.  Kept as published.
-``petn``      PETN at 1.77 g/cc, LLNL Explosives Handbook: B.M. Dobratz and
-              P.C. Crawford, UCRL-52997 Change 2 (1985), JWL table.  Handbook
-              D = 8300 m/s, P_CJ = 33.5 GPa.
-``tnt``       TNT at 1.63 g/cc, same handbook (Dobratz & Crawford 1985); D = 6930 m/s,
-              P_CJ = 21.0 GPa.  (MPM3D-F90 ``Data/Deto1k.mpm`` uses B = 3.21 GPa,
-              E0 = 6.993 GPa, within rounding of these.)
-``anfo``      ANFO at 0.931 g/cc, the ANSYS AUTODYN material-library set widely quoted in
-              rock-blasting studies (D = 4160 m/s, P_CJ ~ 5.15 GPa).  ANFO is non-ideal:
-              treat this set as indicative.
+``emulsion``  Yue, Zhou, Feng, Wang, Peng & Cong, Computers and Geotechnics (2022) 104629
+              (doi 10.1016/j.compgeo.2021.104629), Table 1 ("parameters selected for emulsion
+              explosive"), which in turn cites An, Suorineni, Xu, Li & Wang, Int. J. Rock Mech.
+              Min. Sci. 112 (2018) 84-94 (doi 10.1016/j.ijrmms.2018.10.010).  Its own CJ state
+              (D ~ 5.5 km/s, P_CJ ~ 9.9 GPa) does not match the quoted D = 4000 m/s; see
+              VALIDATION.md §0.  Kept as published.
+``petn``      PETN at 1.77 g/cc: B.M. Dobratz and P.C. Crawford, "LLNL Explosives Handbook:
+              Properties of Chemical Explosives and Explosive Simulants", UCRL-52997 Change 2,
+              Lawrence Livermore National Laboratory, January 1985, table of JWL parameters of
+              the detonation products (A = 6.170 Mbar, B = 0.16926 Mbar, R1 = 4.4, R2 = 1.2,
+              omega = 0.25, E0 = 0.101 Mbar cc/cc; D = 0.830 cm/us, P_CJ = 0.335 Mbar).  The
+              table number was not checked against the handbook itself.
+``tnt``       TNT at 1.63 g/cc, same handbook (Dobratz & Crawford 1985): A = 3.712 Mbar,
+              B = 0.03231 Mbar, R1 = 4.15, R2 = 0.95, omega = 0.30, E0 = 0.070 Mbar cc/cc,
+              D = 0.693 cm/us, P_CJ = 0.21 Mbar.  The same numbers are the TNT example of the
+              Altair Radioss /MAT/JWL documentation (2017.help.altair.com, hwsolvers/matjwl.htm);
+              MPM3D-F90 ``Data/Deto1k.mpm`` uses B = 3.21 GPa, E0 = 6.993 GPa, within rounding.
+``anfo``      ANFO at 0.931 g/cc, D = 4160 m/s: the JWL set of the ANFO entry of the ANSYS
+              AUTODYN material library (A = 49.46 GPa, B = 1.891 GPa, R1 = 3.907, R2 = 1.118,
+              omega = 0.333, E0 = 2.484 GPa), which rock-blasting studies run in AUTODYN and
+              LS-DYNA widely reuse.  No primary publication (a cylinder-test fit) for this set
+              could be located; it is self-consistent (its own CJ point is D_CJ = 4159 m/s,
+              P_CJ = 5.15 GPa).  ANFO is non-ideal (D depends strongly on charge diameter and
+              confinement): treat this set as indicative, and prefer a cylinder-test fit for the
+              product at hand (e.g. the ANFO and emulsion JWL sets of Castedo, Sanchidrian,
+              Lopez, Segarra & Santos, "Jones-Wilkins-Lee parameters for civil explosives").
 """
 
 from __future__ import annotations

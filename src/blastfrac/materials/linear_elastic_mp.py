@@ -6,8 +6,20 @@ Hypoelastic rate form with the Jaumann rate, integrated explicitly:
 
 with D = sym(L), W = skew(L), L the particle velocity gradient [1/s]; stresses in Pa
 (tension positive).  Plane strain: the in-plane response uses lambda, mu of the 3D
-material; sigma_zz does not enter the in-plane forces.  Strain-energy density from the
-in-plane stress: w = 1/2 sigma : C^-1 : sigma (plane strain compliance).
+material; sigma_zz does not enter the in-plane forces.
+
+Stored energy.  A hypoelastic law has no strain-energy function; the energy the material
+holds is the work done on it, accumulated per particle with the trapezoidal rule
+
+    W_p += dt/2 (V_p^n sigma^n + V_p^{n+1} sigma^{n+1}) : D      [J per unit thickness],
+
+which is exactly the energy the grid's internal forces exchange with the motion (for small
+strains it equals 1/2 sigma : C^-1 : sigma V, to which it reduces exactly at constant V).
+The closed form w = 1/2 sigma : C^-1 : sigma (plane-strain compliance) times the current
+volume is kept as a diagnostic: at finite strain it differs from the work by O(strain)
+(the Cauchy stress acts on the current volume, and the Jaumann rate rotates sigma), e.g.
+by 8 % of the kinetic energy at peak compression in the two-disk benchmark, where the
+contact strains reach ~10 %.
 """
 
 from __future__ import annotations
@@ -69,23 +81,38 @@ def strain_energy_density_np(sig, E: float, nu: float):
     return 0.5 * (sxx * exx + syy * eyy + sxy * gxy)
 
 
+def stress_work_increment_np(sig_old, sig_new, vol_old, vol_new, L, dt):
+    """NumPy twin of the work increment dt/2 (V^n sigma^n + V^{n+1} sigma^{n+1}) : sym(L) [J/m]."""
+    Dm = 0.5 * (L + np.swapaxes(L, -1, -2))
+    vs = 0.5 * (np.asarray(vol_old)[..., None, None] * sig_old + np.asarray(vol_new)[..., None, None] * sig_new)
+    return dt * (vs * Dm).sum(axis=(-1, -2))
+
+
 @wp.kernel
 def update_elastic_state(
     active: wp.array(dtype=wp.int32),
     grad_v: wp.array(dtype=wp.mat22d),
     rho: wp.array(dtype=wp.float64),
+    vol_prev: wp.array(dtype=wp.float64),
+    vol: wp.array(dtype=wp.float64),
     dt: wp.float64,
     lam: wp.float64,
     mu: wp.float64,
     stress: wp.array(dtype=wp.mat22d),
     pres: wp.array(dtype=wp.float64),
     cs: wp.array(dtype=wp.float64),
+    work: wp.array(dtype=wp.float64),
 ):
-    """Advance sigma [Pa]; p = -tr(sigma)/2 [Pa]; c = sqrt((lambda + 2 mu)/rho) [m/s]."""
+    """Advance sigma [Pa]; p = -tr(sigma)/2 [Pa]; c = sqrt((lambda + 2 mu)/rho) [m/s]; stored work [J/m]."""
     p = wp.tid()
     if active[p] == 0:
         return
-    s = elastic_stress_update(stress[p], grad_v[p], dt, lam, mu)
+    L = grad_v[p]
+    s0 = stress[p]
+    s = elastic_stress_update(s0, L, dt, lam, mu)
+    Dm = F64(0.5) * (L + wp.transpose(L))
+    vs = F64(0.5) * (vol_prev[p] * s0 + vol[p] * s)
+    work[p] = work[p] + dt * wp.ddot(vs, Dm)
     stress[p] = s
     pres[p] = -F64(0.5) * (s[0, 0] + s[1, 1])
     cs[p] = wp.sqrt((lam + F64(2.0) * mu) / rho[p])

@@ -1,4 +1,5 @@
-"""Grid-node updates (METHOD §2.2 steps 2, 3 and the remap velocity): owner-computes, no atomics."""
+"""Grid-node updates (METHOD §2.2 steps 2, 3 and the remap velocity), owner-computes, and the image-wall
+fold (atomic adds onto image nodes) and ghost update; see :mod:`blastfrac.mpm.grid`."""
 
 from __future__ import annotations
 
@@ -61,3 +62,63 @@ def velocity_from_momentum(
         g_vel[n] = wp.vec2d()
         return
     g_vel[n] = apply_bc(g_mom[n] / m, bc_mask[n], bc_vel[n])
+
+
+@wp.func
+def cmul(a: wp.vec2d, b: wp.vec2d):
+    """Component-wise product."""
+    return wp.vec2d(a[0] * b[0], a[1] * b[1])
+
+
+@wp.kernel
+def fold_wall_images(
+    mirror: wp.array(dtype=wp.int32),
+    sign: wp.array(dtype=wp.vec2d),
+    with_mass_force: int,
+    g_mass: wp.array(dtype=wp.float64),
+    g_mom: wp.array(dtype=wp.vec2d),
+    g_force: wp.array(dtype=wp.vec2d),
+):
+    """Image walls, after a P2G: a ghost node adds its momentum (and mass and force) to its image, signed.
+
+    A node on the wall is its own image (its odd components cancel, its mass doubles).  No race:
+    a ghost is never an image, and a wall node is the image of itself only.
+    """
+    n = wp.tid()
+    k = mirror[n]
+    if k < 0:
+        return
+    sg = sign[n]
+    if k == n:
+        g_mom[n] = g_mom[n] + cmul(sg, g_mom[n])
+        if with_mass_force != 0:
+            g_mass[n] = g_mass[n] + g_mass[n]
+            g_force[n] = g_force[n] + cmul(sg, g_force[n])
+        return
+    wp.atomic_add(g_mom, k, cmul(sg, g_mom[n]))
+    if with_mass_force != 0:
+        wp.atomic_add(g_mass, k, g_mass[n])
+        wp.atomic_add(g_force, k, cmul(sg, g_force[n]))
+
+
+@wp.kernel
+def set_wall_ghosts(
+    mirror: wp.array(dtype=wp.int32),
+    sign: wp.array(dtype=wp.vec2d),
+    g_mass: wp.array(dtype=wp.float64),
+    with_dvel: int,
+    g_vel: wp.array(dtype=wp.vec2d),
+    g_dvel: wp.array(dtype=wp.vec2d),
+    g_mom: wp.array(dtype=wp.vec2d),
+):
+    """Image walls, after the node update: a ghost takes its image's velocity (and increment), signed [m/s]."""
+    n = wp.tid()
+    k = mirror[n]
+    if k < 0 or k == n:
+        return
+    sg = sign[n]
+    v = cmul(sg, g_vel[k])
+    g_vel[n] = v
+    g_mom[n] = g_mass[k] * v
+    if with_dvel != 0:
+        g_dvel[n] = cmul(sg, g_dvel[k])

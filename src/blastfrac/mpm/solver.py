@@ -31,7 +31,7 @@ from blastfrac.mpm.grid import Grid, GridSpec
 from blastfrac.mpm.kernels_burn import update_burn
 from blastfrac.mpm.kernels_eos import update_jwl_state
 from blastfrac.mpm.kernels_g2p import g2p_velocity, update_particle_kinematics
-from blastfrac.mpm.kernels_grid import update_grid_momentum, velocity_from_momentum
+from blastfrac.mpm.kernels_grid import fold_wall_images, set_wall_ghosts, update_grid_momentum, velocity_from_momentum
 from blastfrac.mpm.kernels_misc import max_signal_speed
 from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
 from blastfrac.mpm.seeding import charge_area_centroid, charge_bbox, seed_charges
@@ -75,8 +75,8 @@ class MPMSolver:
     """Explicit MUSL MPM for JWL detonation products (or a linear-elastic solid, for tests).
 
     Particle arrays (shape [n]): x, v, v_pic [m/s], f_ext_p [N/m] (vec2d); mass [kg/m];
-    vol, vol0, vol_prev [m^2]; rho [kg/m^3]; ie [J/m]; p, q [Pa]; burn [-];
-    light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32).
+    vol, vol0, vol_prev [m^2]; rho [kg/m^3]; ie [J/m] (JWL internal energy; elastic solid: the work
+    done on it); p, q [Pa]; burn [-]; light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32).
     Grid arrays: ``self.grid`` (:class:`Grid`).
     """
 
@@ -221,6 +221,7 @@ class MPMSolver:
             outputs=[g.mass, g.mom, g.force],
             device=self.device,
         )
+        self._fold_walls(1)
 
     def update_grid(self, dt: float) -> None:
         """Integrate node momenta over dt [s] with the mass cut-off and boundary conditions."""
@@ -232,6 +233,21 @@ class MPMSolver:
             outputs=[g.mom, g.vel, g.dvel],
             device=self.device,
         )
+        self._wall_ghosts(1)
+
+    def _fold_walls(self, with_mass_force: int) -> None:
+        """Image walls: fold the ghosts' P2G sums onto their images, x walls then y walls."""
+        g = self.grid
+        for a in g.mirror_axes:
+            wp.launch(fold_wall_images, dim=self.spec.node_count, inputs=[g.mirror[a], g.mirror_sign[a], with_mass_force],
+                      outputs=[g.mass, g.mom, g.force], device=self.device)
+
+    def _wall_ghosts(self, with_dvel: int) -> None:
+        """Image walls: ghosts take their images' velocities, x walls then y walls."""
+        g = self.grid
+        for a in g.mirror_axes:
+            wp.launch(set_wall_ghosts, dim=self.spec.node_count, inputs=[g.mirror[a], g.mirror_sign[a], g.mass, with_dvel],
+                      outputs=[g.vel, g.dvel, g.mom], device=self.device)
 
     def to_particles(self, dt: float) -> None:
         """G2P (FLIP/PIC), MUSL remap, velocity gradient, volume and position update."""
@@ -245,6 +261,7 @@ class MPMSolver:
         )
         g.mom.zero_()
         wp.launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.mass, self.active, *geo], outputs=[g.mom], device=d)
+        self._fold_walls(0)
         wp.launch(
             velocity_from_momentum,
             dim=self.spec.node_count,
@@ -252,6 +269,7 @@ class MPMSolver:
             outputs=[g.vel],
             device=d,
         )
+        self._wall_ghosts(0)
         wp.launch(
             update_particle_kinematics,
             dim=self.n,
@@ -268,8 +286,8 @@ class MPMSolver:
             wp.launch(
                 update_elastic_state,
                 dim=self.n,
-                inputs=[self.active, self.grad_v, self.rho, F64(dt), F64(m.lam), F64(m.mu)],
-                outputs=[self.stress, self.p, self.cs],
+                inputs=[self.active, self.grad_v, self.rho, self.vol_prev, self.vol, F64(dt), F64(m.lam), F64(m.mu)],
+                outputs=[self.stress, self.p, self.cs, self.ie],
                 device=d,
             )
             return
@@ -333,7 +351,10 @@ class MPMSolver:
         JWL: internal (sum ie), kinetic, total (internal + kinetic), released_chemical
         (sum F E0 V0: chemical energy liberated by the burn), initial_internal (sum E0 V0)
         and gas_work (initial_internal - internal: work done by the products so far).
-        Elastic: kinetic, strain, total.
+        Elastic: kinetic, strain (the work done on the particles, kept in ``ie``: the stored
+        energy of the hypoelastic law), total (kinetic + strain) and strain_closed_form
+        (sum 1/2 sigma : C^-1 : sigma V, equal to strain at small strain; see
+        :mod:`blastfrac.materials.linear_elastic_mp`).
         """
         a = self._act()
         v = self.v.numpy()[a]
@@ -341,8 +362,8 @@ class MPMSolver:
         if not self.is_jwl:
             m = self.material
             w = strain_energy_density_np(self.stress.numpy()[a], m.E, m.nu)
-            se = float((w * self.vol.numpy()[a]).sum())
-            return {"kinetic": ke, "strain": se, "total": ke + se}
+            se = float(self.ie.numpy()[a].sum())
+            return {"kinetic": ke, "strain": se, "total": ke + se, "strain_closed_form": float((w * self.vol.numpy()[a]).sum())}
         ie = float(self.ie.numpy()[a].sum())
         chem0 = self._chem0[a]
         return {
