@@ -14,6 +14,7 @@ import math
 import numpy as np
 import warp as wp
 
+from .particle_edge import CONTACT_HISTORY
 from .kernels_contact import ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, collect_exposed_elements, eval_particle_edge_contact
 
 
@@ -52,6 +53,10 @@ class GasRockCoupler:
         self.elems = wp.zeros(E, dtype=wp.int32, device=d)
         self.points = wp.zeros(E, dtype=wp.vec3d, device=d)
         self.acc = wp.zeros(3, dtype=wp.float64, device=d)
+        # (particle, element) contact histories, read from one pair and written to the other each step
+        nh = max(1, mpm.n) * CONTACT_HISTORY
+        self._hist = [(wp.full(nh, -1, dtype=wp.int32, device=d), wp.zeros(nh, dtype=wp.float64, device=d))
+                      for _ in range(2)]
         dim = int(min(1024, max(16, math.sqrt(E))))
         self.grid = wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64)
         self.query_radius = 0.0
@@ -101,13 +106,15 @@ class GasRockCoupler:
         wp.launch(_reset_step_acc, dim=1, inputs=[], outputs=[self.acc], device=m.device)
         if self.n_exposed == 0:
             mpm.f_ext_p.zero_()
+            self._hist[0][0].fill_(-1)
             return
         wp.launch(eval_particle_edge_contact, dim=mpm.n,
                   inputs=[self.grid.id, self.elems, self.slot_iface, state.pair_mode, state.x, state.v, m.node_mass,
                           mpm.x, mpm.v_pic, mpm.mass, mpm.vol, mpm.p, mpm.rho, mpm.active,
                           wp.float64(self.kc), wp.float64(self.force_cap), wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
-                          wp.float64(self.query_radius), wp.float64(dt)],
-                  outputs=[mpm.f_ext_p, state.f, self.acc], device=m.device)
+                          wp.float64(self.query_radius), wp.float64(dt), self._hist[0][0], self._hist[0][1]],
+                  outputs=[mpm.f_ext_p, state.f, self.acc, self._hist[1][0], self._hist[1][1]], device=m.device)
+        self._hist.reverse()
 
     def energies(self) -> dict[str, float]:
         """contact_energy: work absorbed by the contacts so far, ∫ −f·(v_p − v_c) dt [J/m] (penalty energy held

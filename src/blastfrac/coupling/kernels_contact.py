@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from .particle_edge import contact_force, edge_overlap, normal_force_cap, vertex_overlap
+from .particle_edge import CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap, vertex_overlap
 
 # slots of the coupling's energy accumulator
 ACC_ABSORBED = 0       # work absorbed by the contacts since the start, ∫ −f·(v_p − v_c) dt [J/m]
@@ -68,15 +68,26 @@ def eval_particle_edge_contact(
     r_max: wp.float64,
     query_radius: wp.float64,
     dt: wp.float64,
+    hist_e_in: wp.array(dtype=wp.int32),
+    hist_d_in: wp.array(dtype=wp.float64),
     f_p: wp.array(dtype=wp.vec2d),
     f_rock: wp.array(dtype=wp.vec2d),
     acc: wp.array(dtype=wp.float64),
+    hist_e_out: wp.array(dtype=wp.int32),
+    hist_d_out: wp.array(dtype=wp.float64),
 ):
-    """Contact force on each particle (assigned to f_p) and its reactions (added to f_rock), METHOD §3."""
+    """Contact force on each particle (assigned to f_p) and its reactions (added to f_rock), METHOD §3.
+
+    hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
+    each (element, ignored initial overlap δ₀ [m]); element −1 marks an empty slot.
+    """
     p = wp.tid()
     zero = wp.float64(0.0)
     one = wp.float64(1.0)
     fsum = wp.vec2d(zero, zero)
+    h0 = p * CONTACT_HISTORY
+    for h in range(CONTACT_HISTORY):
+        hist_e_out[h0 + h] = -1
     if active[p] == 0:
         f_p[p] = fsum
         return
@@ -123,6 +134,17 @@ def eval_particle_edge_contact(
             vc = wa * v_rock[ia] + bxi * v_rock[ib]
             cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
             vrel = vp - vc
+            # initial overlap δ₀: kept from the last step's contact with e, else what a new contact cannot explain
+            d0 = wp.float64(-1.0)
+            for h in range(CONTACT_HISTORY):
+                if hist_e_in[h0 + h] == e:
+                    d0 = wp.min(hist_d_in[h0 + h], best)
+            if d0 < zero:
+                d0 = initial_overlap(best, wp.dot(vrel, bn), dt, rp)
+            if ncon < CONTACT_HISTORY:
+                hist_e_out[h0 + ncon] = e
+                hist_d_out[h0 + ncon] = d0
+            best = best - d0
             fcap = wp.float64(0.0)
             if kappa > zero:
                 fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)

@@ -20,6 +20,17 @@ Force on the particle (per unit thickness) [N/m]:
   incremental history of Y29; μ = 0 by default: an inviscid gas).
 The reaction −f goes to the edge nodes with weights (1 − ξ, ξ) (linear interpolation; see the note on Y30
 in METHOD §3), so momentum is conserved exactly.
+
+**Initial overlaps** (``initial_overlap``). A contact can appear already deep: an interface becomes exposed
+when its last spring separates while an expanded particle (r_p up to h/2) sits in the opening, or a rotating
+fragment sweeps over a particle between two steps. The full penalty k_c·δ would then fire a light gas
+particle at tens of km/s (it did: tests/verification/test_coupling_initial_overlap.py). A contact seen for
+the first time may overlap by δ_new = v_a·Δt + 0.1·r_p (what one step of approach at v_a = max(−v_n, 0)
+plus the equilibrium overlap at P_CJ produce); the excess δ₀ = δ − δ_new is ignored, the force is
+k_c·(δ − δ₀), and δ₀ only shrinks (δ₀ ← min(δ₀, δ)) as the particle backs out, so the contact never
+pulls. The penalty energy then no longer comes from nowhere. δ₀ is kept per (particle, element) for up to
+CONTACT_HISTORY elements per particle and forgotten once the contact ends (LS-DYNA's treatment of initial
+penetrations, IGNORE = 1, is the same idea).
 """
 
 from __future__ import annotations
@@ -28,6 +39,11 @@ import numpy as np
 import warp as wp
 
 NO_CONTACT = -1.0
+#: overlap a new contact may have without being treated as an initial penetration, as a fraction of r_p [-]
+NEW_CONTACT_SLACK_NP = 0.1
+NEW_CONTACT_SLACK = wp.constant(wp.float64(NEW_CONTACT_SLACK_NP))
+#: (particle, element) contact histories kept per particle
+CONTACT_HISTORY = wp.constant(8)
 
 
 @wp.func
@@ -83,6 +99,13 @@ def contact_force(delta: wp.float64, n: wp.vec2d, vrel: wp.vec2d, kc: wp.float64
 
 
 @wp.func
+def initial_overlap(delta: wp.float64, vn: wp.float64, dt: wp.float64, rp: wp.float64):
+    """Part δ₀ [m] of a first-seen overlap δ that one step of approach at −v_n [m/s] cannot explain."""
+    allowed = wp.max(-vn, wp.float64(0.0)) * dt + NEW_CONTACT_SLACK * rp
+    return wp.max(delta - allowed, wp.float64(0.0))
+
+
+@wp.func
 def normal_force_cap(kappa: wp.float64, p: wp.float64, rho: wp.float64, vn: wp.float64, rp: wp.float64):
     """κ·(p + ρ·v_a²)·2r_p [N/m]: the most a gas particle of pressure p [Pa], density ρ [kg/m³] approaching at
     v_a = max(−v_n, 0) [m/s] may push on one contact. It holds a particle at rest against its pressure (needs
@@ -113,6 +136,11 @@ def vertex_overlap_np(xp, rp, xa):
     if rp > dist > 1e-12 * rp:
         return rp - dist, r / dist
     return NO_CONTACT, np.zeros(2)
+
+
+def initial_overlap_np(delta, vn, dt, rp):
+    """NumPy twin of :func:`initial_overlap` [m]."""
+    return max(delta - (max(-vn, 0.0) * dt + NEW_CONTACT_SLACK_NP * rp), 0.0)
 
 
 def normal_force_cap_np(kappa, p, rho, vn, rp):

@@ -141,7 +141,10 @@ class ModelBuilder:
             np.add.at(row[:, 0], pn[:, col], rx)
             np.add.at(row[:, 1], pn[:, col], ry)
         omega2 = np.max(row / h["node_mass"][:, None])
-        return 2.0 / math.sqrt(omega2)
+        # a dashpot of ratio ζ on the stiffest mode lowers the central-difference limit to
+        # (2/ω)(√(1+ζ²) − ζ) (Belytschko, Liu & Moran, Nonlinear FE, §6.3)
+        zeta = self.scenario.rock.spring_damping
+        return 2.0 / math.sqrt(omega2) * (math.sqrt(1.0 + zeta**2) - zeta)
 
     # ------------------------------------------------------------------ device
     def finalize(self, device: str = "cpu") -> Model:
@@ -161,6 +164,8 @@ class ModelBuilder:
             tan_phi_r=math.tan(math.radians(rock.residual_friction)),
             slope_t=self.slope_t, slope_c=self.slope_c,
             breakable=0 if rock.unbreakable else 1,
+            q_quad=rock.bulk_viscosity_quadratic, q_lin=rock.bulk_viscosity_linear,
+            spring_damping=rock.spring_damping,
             node_mass=arr(h["node_mass"], wp.float64),
             node_X=arr(h["node_X"], wp.vec2d),
             node_pairs=arr(self.topology.node_pairs.astype(np.int32), wp.vec2i),

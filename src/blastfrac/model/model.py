@@ -31,6 +31,8 @@ class Model:
     pair_ac: tributary area Ac (edge length/2, unit thickness) [m], [P]
     pair_l0: length of the edge the spring belongs to [m], [P]
     pair_t0, pair_c0: initial tensile strength and cohesion [Pa], [P]
+    spring_damping: dashpot ratio ζ beside every loaded spring [-] (materials.interface.spring_dashpot)
+    q_quad, q_lin: coefficients of the blocks' artificial bulk viscosity [-] (materials/artificial_viscosity.py)
     ledge_n0, ledge_n1: nodes of loaded boundary edges (n0→n1 runs counter-clockwise around the element), [L]
     ledge_pulse: pulse index or −1, [L]; ledge_f0: constant force on each of its nodes [N/m], [L] vec2d
     """
@@ -68,7 +70,15 @@ class Model:
     ledge_f0: wp.array
     pulses: list = field(default_factory=list)
     stable_dt: float = 0.0
+    q_quad: float = 0.0
+    q_lin: float = 0.0
+    spring_damping: float = 0.0
     host: dict = field(default_factory=dict)
+
+    @property
+    def c_p(self) -> float:
+        """Plane-strain P-wave speed of the blocks √((λ+2G)/ρ) [m/s]."""
+        return ((self.lam + 2.0 * self.mu) / self.density) ** 0.5
 
     @property
     def element_count(self) -> int:

@@ -104,6 +104,20 @@ class RockConfig(_Strict):
         None, gt=0, description="Mode II fracture energy G_fII [J/m²]; enables linear cohesion softening."
     )
     unbreakable: bool = Field(False, description="Springs never fail (elastic verification runs).")
+    bulk_viscosity_linear: float = Field(
+        0.0, ge=0, le=2, description="Linear artificial bulk viscosity coefficient C_l of the blocks [-] "
+        "(q = ρl(C_q·l·trD² − C_l·c_p·trD) in compression, l = √A). Damps the mesh-scale ringing behind steep "
+        "blast fronts that otherwise breaks springs no continuum stress would break; see docs/scenario.md.",
+    )
+    spring_damping: float = Field(
+        0.0, ge=0, le=1, description="Dashpot beside every loaded spring as a fraction ζ of the critical damping "
+        "of its two-node oscillator [-]. Damps mesh-scale vibration of the node pairs (the model's highest "
+        "frequency); its force is not part of the spring force that the failure criteria see.",
+    )
+    bulk_viscosity_quadratic: float = Field(
+        0.0, ge=0, le=4, description="Quadratic (von Neumann–Richtmyer) artificial bulk viscosity coefficient "
+        "C_q of the blocks [-]; see bulk_viscosity_linear.",
+    )
 
     @model_validator(mode="after")
     def _check_stiffness(self) -> "RockConfig":
