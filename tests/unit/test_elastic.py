@@ -39,3 +39,13 @@ def test_uniaxial_strain_gives_p_wave_modulus():
     np.testing.assert_allclose(s, [M * 1e-6, nu / (1 - nu) * M * 1e-6, 0.0], rtol=1e-12)
     # energy density ½ M ε²
     np.testing.assert_allclose(elastic.np_strain_energy_density(s, lam, mu), 0.5 * M * 1e-12, rtol=1e-12)
+
+
+def test_bulk_viscosity_formula():
+    """q = C_q ρ l² (trD)² − C_l ρ l c trD in compression, 0 in expansion (von Neumann–Richtmyer + Landshoff)."""
+    from blastfrac.materials.artificial_viscosity import np_bulk_viscosity
+
+    rho, l, c = 2600.0, 1e-3, 5000.0
+    assert np_bulk_viscosity(1e4, rho, l, c, 1.5, 0.5) == 0.0
+    trD = -2e5
+    assert abs(np_bulk_viscosity(trD, rho, l, c, 1.5, 0.5) - (1.5 * rho * l**2 * 4e10 + 0.5 * rho * l * c * 2e5)) < 1e-6

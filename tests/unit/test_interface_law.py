@@ -121,3 +121,31 @@ def test_tension_softening_dissipates_gf(gf):
 def test_snap_back_is_rejected():
     with pytest.raises(ValueError, match="snap back"):
         law.softening_slope(10e6, 1e-3, 1e12)
+
+
+def test_spring_dashpot_matches_numpy_twin_and_dissipates():
+    """Warp dashpot force equals its NumPy twin; it always opposes the relative velocity (power ≤ 0)."""
+    import warp as wp
+
+    from blastfrac.materials.interface import np_spring_dashpot, spring_dashpot
+
+    @wp.kernel
+    def k(dv: wp.array(dtype=wp.vec2d), out: wp.array(dtype=wp.vec2d)):
+        i = wp.tid()
+        t = wp.normalize(wp.vec2d(wp.float64(1.0), wp.float64(2.0)))
+        n = wp.vec2d(t[1], -t[0])
+        out[i] = spring_dashpot(dv[i], n, t, wp.float64(3e11), wp.float64(1e11), wp.float64(2e-3),
+                                wp.float64(5e-3), wp.float64(0.1))
+
+    rng = np.random.default_rng(1)
+    dv = rng.normal(size=(20, 2)) * 100
+    out = wp.zeros(20, dtype=wp.vec2d, device="cpu")
+    wp.launch(k, dim=20, inputs=[wp.array(dv, dtype=wp.vec2d, device="cpu")], outputs=[out], device="cpu")
+    t = np.array([1.0, 2.0]) / np.sqrt(5)
+    n = np.array([t[1], -t[0]])
+    want = np.array([np_spring_dashpot(d, n, t, 3e11, 1e11, 2e-3, 5e-3, 0.1) for d in dv])
+    np.testing.assert_allclose(out.numpy(), want, rtol=1e-12)
+    m_eff = 2e-3 * 5e-3 / 7e-3
+    cn = 2 * 0.1 * np.sqrt(m_eff * 3e11)                 # 2ζ√(m_eff K) from the definition
+    np.testing.assert_allclose(want @ n, -cn * (dv @ n), rtol=1e-12)
+    assert np.all(np.einsum("ij,ij->i", want, dv) <= 0)
