@@ -1,7 +1,8 @@
 """Simulated Brazilian (splitting) test of a disc loaded across a diameter by two platens.
 
-σ_t = 2P/(π·D·t) at the peak load P [N/m] (t = 1 m: 2D, unit thickness). Platens are either
-flat or ISRM-style concave jaws (radius 1.5 × disc radius by default), frictionless.
+σ_t = 2P/(π·D·t) at the peak load P [N/m] (t = 1 m: 2D, unit thickness). The jaws are frictionless;
+by default conforming (radius = disc radius) and acting on the rim nodes of a loading arc
+2α = 15° (the arc-loaded Brazilian test), optionally ISRM curved jaws (radius 1.5 R) or flat.
 The initiation check records where the first tensile spring failures occur: a valid test
 splits from the centre, not from the loaded points.
 """
@@ -78,10 +79,11 @@ def analyse_brazilian(spec: Specimen, run: LoadResult, settings: LoadSettings) -
 
 
 def brazilian_settings(settings: LoadSettings | None = None) -> LoadSettings:
-    """Defaults of the Brazilian test: ISRM jaws (1.5 R), finer sampling (smaller strains)."""
+    """Defaults of the Brazilian test: conforming jaws on a 15° loading arc, finer sampling (smaller
+    strains than the UCS test), and the quasi-static defaults of :class:`LoadSettings`."""
     if settings is not None:
         return settings
-    return LoadSettings(jaw_ratio=1.5, sample_strain=2e-6, max_strain=0.005)
+    return LoadSettings(jaw_ratio=1.0, loading_arc=15.0, sample_strain=2e-6, max_strain=0.005)
 
 
 def run_brazilian(rock: RockConfig, settings: LoadSettings | None = None, mesh_size: float | None = None,

@@ -17,13 +17,19 @@ def add_parser(sub) -> None:
     add_scenario_args(p)
     p.add_argument("--out", default=None, help="output directory (default: <output.directory>/calibration)")
     p.add_argument("--fit", default=None, metavar="TARGETS.toml", help="fit micro-parameters to these targets")
-    p.add_argument("--budget", type=int, default=30, help="most simulations the fit may run (default 30)")
+    p.add_argument("--budget", type=int, default=40,
+                   help="most quasi-static runs the fit may make (default 40; static elastic solves are free)")
+    p.add_argument("--search-mesh-size", type=float, default=None, metavar="H",
+                   help="fit: element size [m] of both specimens for the strength search and the sensitivities; "
+                        "the search result is then refined on the final meshes (default: search on the final meshes)")
+    p.add_argument("--no-refine", action="store_true",
+                   help="fit: stop after the search meshes (the final tests then only verify the result)")
     p.add_argument("--mesh-size", type=float, default=None, metavar="H",
                    help="element size of both specimens [m] (default: sizes giving the paper's 3734/2167 elements)")
     p.add_argument("--ucs-mesh-size", type=float, default=None, metavar="H", help="element size of the UCS prism [m]")
     p.add_argument("--brazilian-mesh-size", type=float, default=None, metavar="H", help="element size of the disc [m]")
     p.add_argument("--speed", type=float, default=None, help="platen speed, each platen [m/s] (default 0.025)")
-    p.add_argument("--damping", type=float, default=None, help="local damping α (default 0.8)")
+    p.add_argument("--damping", type=float, default=None, help="Cundall local damping α (default 0: undamped, see docs)")
     p.add_argument("--platens", choices=("frictionless", "bonded"), default="frictionless",
                    help="UCS platen condition: free lateral slip (default) or no-slip")
     p.add_argument("--loading-arc", type=float, default=None, metavar="DEG",
@@ -51,16 +57,22 @@ def _settings(args):
         if not 0 <= args.damping < 1:
             raise ScenarioError("--damping must be in [0, 1)")
         common["damping"] = args.damping
-    for name in ("mesh_size", "ucs_mesh_size", "brazilian_mesh_size", "loading_arc", "jaw_ratio"):
+    for name in ("mesh_size", "ucs_mesh_size", "brazilian_mesh_size", "search_mesh_size", "loading_arc", "jaw_ratio"):
         v = getattr(args, name)
         if v is not None and v < 0 or (v is not None and v == 0 and "mesh" in name):
             raise ScenarioError(f"--{name.replace('_', '-')} must be positive")
     if args.budget <= 0:
         raise ScenarioError("--budget must be a positive integer")
     us = LoadSettings(**common, bonded=args.platens == "bonded")
-    bs = LoadSettings(**common, jaw_ratio=1.0 if args.jaw_ratio is None else args.jaw_ratio,
-                      loading_arc=15.0 if args.loading_arc is None else args.loading_arc,
-                      sample_strain=2e-6, max_strain=0.005)
+    from dataclasses import replace
+
+    from ..calibration.brazilian import brazilian_settings
+
+    bs = replace(brazilian_settings(), **common)
+    if args.jaw_ratio is not None:
+        bs = replace(bs, jaw_ratio=args.jaw_ratio)
+    if args.loading_arc is not None:
+        bs = replace(bs, loading_arc=args.loading_arc)
     return us, bs
 
 
@@ -145,20 +157,33 @@ def _speed_check(prog, rock, us, bs, hu, hb, seed, dev, ucs, braz) -> dict:
 def _fit(args, rock, us, bs, hu, hb, seed, dev, out: Path):
     import tomli_w
 
-    from ..calibration.fit import Lab, fit, load_targets
+    from ..calibration.fit import Lab, fit, load_targets, sensitivity_table
 
     cfg = load_targets(args.fit)
-    print(f"fitting {sorted(cfg.targets)} with a budget of {args.budget} simulations")
-    lab = Lab(args.budget, us, bs, hu, hb, seed, dev)
-    rep = fit(rock, cfg, lab)
+    print(f"fitting {sorted(cfg.targets)} with a budget of {args.budget} quasi-static runs")
+    budget = [args.budget, 0]
+    lab = Lab(budget, us, bs, hu, hb, seed, dev, name="final")
+    search = None
+    if args.search_mesh_size:
+        search = Lab(budget, us, bs, args.search_mesh_size, args.search_mesh_size, seed, dev, name="search")
+    rep = fit(rock, cfg, lab, search, refine=not args.no_refine)
     (out / "fit.json").write_text(json.dumps(rep, indent=2, default=float))
     fitted = type(rock).model_validate(rep["fitted"])
     keep = {k: v for k, v in fitted.model_dump().items() if v is not None}
     (out / "fitted_rock.toml").write_text(tomli_w.dumps({"rock": keep}))
     print("fitted: kn = {kn:.4g} Pa/m, ks = {ks:.4g} Pa/m, T = {t:.4g} MPa, c = {c:.4g} MPa, φ = {p:g}° "
-          "({n} simulations)".format(kn=fitted.kn or float("nan"), ks=fitted.ks or float("nan"),
-                                     t=fitted.tensile_strength / 1e6, c=fitted.cohesion / 1e6,
-                                     p=fitted.friction_angle, n=rep["simulations"]))
+          "({n} runs, {s} static solves, {w:.0f} s)".format(
+              kn=fitted.kn or float("nan"), ks=fitted.ks or float("nan"), t=fitted.tensile_strength / 1e6,
+              c=fitted.cohesion / 1e6, p=fitted.friction_angle, n=rep["simulations"], s=rep["static_solves"],
+              w=rep["wall_s"]))
+    if "stopped" in rep:
+        print(f"  fit stopped early: {rep['stopped']}")
     for k, e in rep["relative_error"].items():
-        print(f"  {k}: achieved {rep['achieved'][k]:.4g}, target {cfg.targets[k]:.4g} ({e:+.2%})")
-    return fitted, {k: rep[k] for k in ("targets", "fitted", "achieved", "relative_error", "simulations")}
+        print(f"  {k}: achieved {rep['achieved'][k]:.4g}, target {cfg.targets[k]:.4g} ({e:+.2%}) "
+              f"[{rep['achieved_on']} meshes]")
+    sens = rep.get("sensitivity", {})
+    if "base" in sens:
+        print(f"sensitivities d ln(macro)/d ln(micro) on the {sens['mesh']} meshes:")
+        print(sensitivity_table(sens))
+    keys = ("targets", "fitted", "achieved", "achieved_on", "relative_error", "simulations", "static_solves", "wall_s")
+    return fitted, {k: rep[k] for k in keys}
