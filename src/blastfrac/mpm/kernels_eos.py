@@ -4,17 +4,10 @@ from __future__ import annotations
 
 import warp as wp
 
+from blastfrac.materials.artificial_viscosity import bulk_viscosity  # noqa: F401 (shared with the rock)
 from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq
 
 F64 = wp.float64
-
-
-@wp.func
-def bulk_viscosity(trD: wp.float64, rho: wp.float64, l: wp.float64, c: wp.float64, q1: wp.float64, q2: wp.float64):
-    """Artificial bulk viscosity q [Pa] (compression only): Q1 rho l^2 trD^2 - Q2 rho l c trD."""
-    if trD >= F64(0.0):
-        return F64(0.0)
-    return q1 * rho * l * l * trD * trD - q2 * rho * l * c * trD
 
 
 @wp.kernel
