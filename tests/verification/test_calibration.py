@@ -1,11 +1,13 @@
-"""Simulated laboratory tests (issue 5): coarse UCS and Brazilian runs.
+"""Simulated laboratory tests (issue 5): a coarse UCS and a coarse Brazilian run.
 
-- The elastic slope of the UCS test matches the analytic effective modulus of the block–spring
-  system (METHOD §1.2, computed here from the formula) within 5 %.
-- Strengths are positive and finite, and move by less than STRENGTH_RTOL when the platen speed
-  is halved (quasi-static control).
+- The elastic slope of the UCS run matches the analytic effective modulus of the block–spring
+  medium (METHOD §1.2, written out below) within 5 %.
+- The strengths are positive and finite and move by at most 2 % when the platen speed is halved
+  (the documented quasi-static control: LoadSettings() defaults, undamped, 0.05 m/s per platen).
 - The Brazilian disc splits: its first tensile failures lie in the central part of the disc.
-- The platen contact force (Warp) equals its NumPy twin.
+- The exact static solve of the prism agrees with the formula and, with the paper's stiff springs,
+  stays below the blocks' modulus (springs only add compliance).
+- Helpers: first-peak reading, the fit's 1-D root finder, the platen contact force (Warp = NumPy).
 """
 
 from __future__ import annotations
@@ -17,49 +19,63 @@ import numpy as np
 import pytest
 
 from blastfrac.calibration import LoadSettings, run_brazilian, run_ucs
+from blastfrac.calibration.brazilian import brazilian_settings
 from blastfrac.calibration.curves import first_peak, plane_strain_to_3d
 from blastfrac.scenario.schema import RockConfig
-from conftest import effective_plane_strain_moduli, interior_edge_density
 
-KN, KS = 2e14, 1e14            # Pa/m: soft enough that the springs add ~10 % compliance
-ROCK = RockConfig(density=2600.0, youngs_modulus=50e9, poisson_ratio=0.2, stiffness_mode="per_area", kn=KN, ks=KS,
-                  tensile_strength=5e6, cohesion=12e6, friction_angle=30.0)
-MESH = 0.006                    # m: 432-element prism, coarse disc
-SPEED = 0.02                    # m/s per platen
-# Allowed change of UCS and σt when the speed is halved. Measured on this coarse disc the
-# damped strength falls about linearly with speed (3.83, 3.47, 3.21 MPa at 0.1, 0.05, 0.025 m/s),
-# so 0.02 → 0.01 m/s should move it by ~3 %; 5 % leaves room for mesh-scale noise.
-STRENGTH_RTOL = 0.05
+E_BLOCK, NU_BLOCK = 50e9, 0.2  # Table 2 blocks
+KN, KS = 2e14, 1e14            # Pa/m: soft enough that the springs add ~9 % compliance on the prism
+# the paper's Table 3 strengths on these softer springs
+ROCK = RockConfig(density=2600.0, youngs_modulus=E_BLOCK, poisson_ratio=NU_BLOCK, stiffness_mode="per_area",
+                  kn=KN, ks=KS, tensile_strength=14e6, cohesion=26e6, friction_angle=60.0)
+UCS_MESH = 0.006                # m: 432-element prism
+DISC_MESH = 0.003               # m: ~780-element disc (coarser discs fail at the jaws before they split)
+SPEED = LoadSettings().speed    # the documented quasi-static control
+HALVING_RTOL = 0.02             # issue 5: halving the speed moves the peak by at most 2 %
+
+
+def analytic_plane_strain_moduli(E: float, nu: float, ell: float, kn: float, ks: float) -> tuple[float, float]:
+    """METHOD §1.2: 1/E'_eff = 1/E' + ℓ(3/(8kn) + 1/(8ks)), ν'_eff/E'_eff = ν'/E' − ℓ(1/kn − 1/ks)/8."""
+    Ep, nup = E / (1 - nu**2), nu / (1 - nu)
+    Ep_eff = 1.0 / (1.0 / Ep + ell * (3.0 / (8.0 * kn) + 1.0 / (8.0 * ks)))
+    return Ep_eff, Ep_eff * (nup / Ep - ell * (1.0 / kn - 1.0 / ks) / 8.0)
+
+
+def edge_density(model) -> float:
+    """ℓ: interior edge length per unit area of the mesh [1/m]."""
+    return float(model.host["pair_l0"][0::2].sum() / model.host["elem_area0"].sum())
 
 
 @pytest.fixture(scope="module")
 def ucs_pair():
-    s = LoadSettings(speed=SPEED)
-    return run_ucs(ROCK, s, MESH), run_ucs(ROCK, replace(s, speed=SPEED / 2), MESH)
+    s = LoadSettings()
+    return run_ucs(ROCK, s, UCS_MESH), run_ucs(ROCK, replace(s, speed=SPEED / 2), UCS_MESH)
 
 
 @pytest.fixture(scope="module")
 def braz_pair():
-    s = LoadSettings(speed=SPEED, jaw_ratio=1.0, loading_arc=15.0, sample_strain=2e-6, max_strain=0.005)
-    return run_brazilian(ROCK, s, MESH), run_brazilian(ROCK, replace(s, speed=SPEED / 2), MESH)
+    s = brazilian_settings()
+    return run_brazilian(ROCK, s, DISC_MESH), run_brazilian(ROCK, replace(s, speed=SPEED / 2), DISC_MESH)
 
 
-def test_ucs_elastic_modulus_matches_spring_compliance_formula(ucs_pair):
-    r = ucs_pair[1]
-    Ep_eff, nup_eff = effective_plane_strain_moduli(ROCK.youngs_modulus, ROCK.poisson_ratio,
-                                                    interior_edge_density(r.specimen.model), KN, KS)
-    Ep_blocks = ROCK.youngs_modulus / (1 - ROCK.poisson_ratio**2)
-    print(f"E' measured {r.youngs_modulus_ps / 1e9:.2f} GPa, analytic {Ep_eff / 1e9:.2f} GPa "
-          f"(blocks alone {Ep_blocks / 1e9:.2f}); ν' {r.poisson_ratio_ps:.4f} vs {nup_eff:.4f}")
-    # the springs must soften the blocks visibly, or this test could not tell the formula from E'
-    assert Ep_eff < 0.96 * Ep_blocks
-    assert r.youngs_modulus_ps == pytest.approx(Ep_eff, rel=0.05)
-    assert r.poisson_ratio_ps == pytest.approx(nup_eff, abs=0.03)
-    E, nu = plane_strain_to_3d(r.youngs_modulus_ps, r.poisson_ratio_ps)
-    assert (r.youngs_modulus, r.poisson_ratio) == pytest.approx((E, nu))
+def test_ucs_elastic_modulus_matches_analytic_effective_modulus(ucs_pair):
+    ell = edge_density(ucs_pair[0].specimen.model)
+    Ep_eff, nup_eff = analytic_plane_strain_moduli(E_BLOCK, NU_BLOCK, ell, KN, KS)
+    Ep_blocks = E_BLOCK / (1 - NU_BLOCK**2)
+    # the springs must soften the blocks visibly, or the test could not tell the formula from E'
+    assert Ep_eff < 0.95 * Ep_blocks
+    for r in ucs_pair:
+        print(f"v = {r.settings.speed} m/s: E' measured {r.youngs_modulus_ps / 1e9:.3f} GPa, analytic "
+              f"{Ep_eff / 1e9:.3f} GPa (blocks alone {Ep_blocks / 1e9:.2f}); ν' {r.poisson_ratio_ps:.4f} vs "
+              f"{nup_eff:.4f}")
+        assert r.youngs_modulus_ps == pytest.approx(Ep_eff, rel=0.05)
+        assert r.youngs_modulus_ps < Ep_blocks
+        assert r.poisson_ratio_ps == pytest.approx(nup_eff, abs=0.02)
+        E, nu = plane_strain_to_3d(r.youngs_modulus_ps, r.poisson_ratio_ps)
+        assert (r.youngs_modulus, r.poisson_ratio) == pytest.approx((E, nu))
 
 
-def test_ucs_strength_is_finite_and_quasi_static(ucs_pair):
+def test_ucs_strength_positive_finite_and_stable_at_half_speed(ucs_pair):
     full, half = ucs_pair
     for r in ucs_pair:
         assert math.isfinite(r.ucs) and r.ucs > 0
@@ -67,30 +83,57 @@ def test_ucs_strength_is_finite_and_quasi_static(ucs_pair):
         assert r.peak_index < len(r.stress) - 1         # a real peak, followed by failure
     change = (half.ucs - full.ucs) / full.ucs
     print(f"UCS {full.ucs / 1e6:.2f} MPa at {SPEED} m/s, {half.ucs / 1e6:.2f} MPa at half speed ({change:+.2%})")
-    assert abs(change) < STRENGTH_RTOL
+    assert abs(change) <= HALVING_RTOL
 
 
-def test_brazilian_strength_and_central_initiation(braz_pair):
+def test_brazilian_strength_positive_finite_stable_and_central(braz_pair):
     full, half = braz_pair
     for r in braz_pair:
         assert math.isfinite(r.tensile_strength) and r.tensile_strength > 0
-        # 2P/(πD) at the recorded peak load
-        assert r.tensile_strength == pytest.approx(2 * r.load.max() / (math.pi * 0.054), rel=0.2)
+        assert r.tensile_strength == pytest.approx(2 * r.load[r.peak_index] / (math.pi * 0.054), rel=1e-12)
     change = (half.tensile_strength - full.tensile_strength) / full.tensile_strength
-    print(f"σt {full.tensile_strength / 1e6:.2f} MPa, half speed {half.tensile_strength / 1e6:.2f} MPa "
-          f"({change:+.2%}); first tensile failures median r/R = {half.initiation_radius:.2f}")
-    assert abs(change) < STRENGTH_RTOL
-    xy = half.first_tensile_xy
-    assert len(xy) > 0
-    # splitting: the first tensile failures lie near the loaded diameter, not at the platens' ends
-    assert np.median(np.abs(xy[:, 0])) < 0.25 * 0.027
-    assert half.initiation_radius < 0.6
+    print(f"σt {full.tensile_strength / 1e6:.3f} MPa, half speed {half.tensile_strength / 1e6:.3f} MPa "
+          f"({change:+.2%}); first tensile failures median r/R = {full.initiation_radius:.2f}, "
+          f"{half.initiation_radius:.2f}")
+    assert abs(change) <= HALVING_RTOL
+    for r in braz_pair:
+        xy = r.first_tensile_xy
+        assert len(xy) > 0
+        # splitting: the first tensile failures lie near the loaded diameter, in the central part
+        assert np.median(np.abs(xy[:, 0])) < 0.25 * 0.027
+        assert r.initiation_radius < 0.6
+
+
+def test_static_solve_matches_formula_and_stays_below_blocks_with_table3_springs():
+    """The paper's Table 3 springs (kn 1.8e15, ks 1.6e15 Pa/m) are stiff: E' must sit just below the
+    blocks' E' (the excess once measured with local damping α = 0.8 was a loading artefact)."""
+    from blastfrac.calibration.elastic import static_moduli
+    from blastfrac.calibration.specimens import ucs_specimen
+
+    for kn, ks in ((1.8e15, 1.6e15), (KN, KS)):
+        rock = ROCK.model_copy(update={"kn": kn, "ks": ks, "unbreakable": True})
+        spec = ucs_specimen(rock, UCS_MESH)
+        Ep, nup = static_moduli(spec)
+        Ep_eff, nup_eff = analytic_plane_strain_moduli(E_BLOCK, NU_BLOCK, edge_density(spec.model), kn, ks)
+        assert Ep < E_BLOCK / (1 - NU_BLOCK**2)
+        assert Ep == pytest.approx(Ep_eff, rel=0.005)
+        assert nup == pytest.approx(nup_eff, abs=0.002)
 
 
 def test_first_peak_ignores_post_failure_rehardening():
     s = np.array([0, 10, 20, 30, 29, 25, 31, 40, 10.0])
     assert first_peak(s, 0.02) == 3
     assert first_peak(np.array([0, 1, 2, 3.0]), 0.02) == 3
+
+
+def test_fit_root_finder_power_law_and_flat_response():
+    from blastfrac.calibration.fit import fit_scalar
+
+    x, y, pts = fit_scalar(lambda T: 0.6 * T**0.9, 20.0, 7.4, 0.005, 6, log=lambda *_: None)
+    assert abs(y - 7.4) <= 0.005 * 7.4 and len(pts) <= 3
+    # a response that saturates (coarse disc failing at the jaws): stop, do not run away
+    x, y, pts = fit_scalar(lambda T: min(0.5 * T, 7.5), 8.0, 8.0, 0.02, 6, log=lambda *_: None)
+    assert len(pts) <= 3 and all(p[0] <= 8.0 * 3.0**2 for p in pts)
 
 
 def test_platen_force_warp_matches_numpy():

@@ -55,7 +55,7 @@ def curves_figure(path: Path, ucs=None, braz=None, title: str = "") -> Path:
     """Stress–strain curve of the UCS test (axial and lateral) and load–closure of the Brazilian test."""
     plt = _plt()
     n = (ucs is not None) + (braz is not None)
-    fig, axes = plt.subplots(1, n, figsize=(6 * n, 4.3), squeeze=False)
+    fig, axes = plt.subplots(1, n, figsize=(6 * n, 5.0), squeeze=False)
     k = 0
     if ucs is not None:
         ax = axes[0, k]
@@ -70,11 +70,21 @@ def curves_figure(path: Path, ucs=None, braz=None, title: str = "") -> Path:
                 label=f"E' {ucs.youngs_modulus_ps / 1e9:.1f} GPa (E {ucs.youngs_modulus / 1e9:.1f} GPa, "
                       f"ν {ucs.poisson_ratio:.3f})")
         ax.axvline(0, color="0.8", lw=0.6)
+        # the lateral strain runs away after an undamped, brittle failure: keep the pre-peak part readable
+        lat_peak = abs(float(ucs.lateral_strain[ip]))
+        left = -max(2.5 * lat_peak, 0.3 * float(ucs.strain[ip])) * 1e3
+        if np.nanmin(-ucs.lateral_strain) * 1e3 < left:
+            ax.set_xlim(left=left)
+            ax.text(left, 0.5 * s[ip], " post-peak lateral\n strain off scale", fontsize=7, color="0.4")
         ax.set_xlabel("strain [‰] (lateral: extension to the left)")
         ax.set_ylabel("axial stress [MPa] (plane strain)")
+        ref = ucs.reference.get("static")
+        if ref:
+            ax.plot(e * 1e3, ref["youngs_modulus_ps"] * e / 1e6, ":", color="tab:purple", lw=1.2,
+                    label=f"static solve E' {ref['youngs_modulus_ps'] / 1e9:.2f} GPa")
         ax.set_title(f"UCS test, {ucs.specimen.element_count} elements, platen speed "
-                     f"{ucs.settings.speed * 1e3:g} mm/s", fontsize=10)
-        ax.legend(fontsize=8, loc="lower right")
+                     f"{ucs.settings.speed * 1e3:g} mm/s, α = {ucs.settings.damping:g}", fontsize=10)
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, frameon=False)
         ax.set_ylim(bottom=0)
     if braz is not None:
         ax = axes[0, k]
@@ -87,7 +97,8 @@ def curves_figure(path: Path, ucs=None, braz=None, title: str = "") -> Path:
                 label=f"σt = 2P/(πD) = {braz.tensile_strength / 1e6:.2f} MPa")
         ax.set_xlabel("platen closure [µm]")
         ax.set_ylabel("2P/(πD) [MPa]")
-        ax.set_title(f"Brazilian test, {braz.specimen.element_count} elements", fontsize=10)
+        ax.set_title(f"Brazilian test, {braz.specimen.element_count} elements, platen speed "
+                     f"{braz.settings.speed * 1e3:g} mm/s, α = {braz.settings.damping:g}", fontsize=10)
         ax.legend(fontsize=8, loc="lower right")
         ax.set_ylim(bottom=0)
     if title:
@@ -106,8 +117,17 @@ def specimens_figure(path: Path, ucs=None, braz=None, title: str = "") -> Path:
                              gridspec_kw={"width_ratios": [1, 1.4][:n] if n == 2 else [1]})
     k = 0
     if ucs is not None:
-        draw_specimen(axes[0, k], ucs.specimen, ucs.run.pair_mode,
-                      title=f"UCS after failure (ε = {ucs.strain[-1] * 1e3:.2f} ‰)")
+        run = ucs.run
+        if run.pair_mode_failure is not None:
+            # undamped, the prism shatters within a few samples after the peak; the state when the
+            # load first drops below the peak shows the failure mechanism
+            i = run.failure_index
+            draw_specimen(axes[0, k], ucs.specimen, run.pair_mode_failure,
+                          title=f"UCS at failure (ε = {ucs.strain[i] * 1e3:.2f} ‰,\n"
+                                f"σ = {ucs.stress[i] / 1e6:.0f} MPa after the {ucs.ucs / 1e6:.0f} MPa peak)")
+        else:
+            draw_specimen(axes[0, k], ucs.specimen, run.pair_mode,
+                          title=f"UCS at the end (ε = {ucs.strain[-1] * 1e3:.2f} ‰)")
         k += 1
     if braz is not None:
         draw_specimen(axes[0, k], braz.specimen, braz.run.pair_mode, marks=braz.first_tensile_xy,

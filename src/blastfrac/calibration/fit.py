@@ -14,8 +14,8 @@ Staged; each stage is a small, documented scipy problem (METHOD §5.4):
    target E above the blocks' (or ν below the blocks' with ks ≤ kn) is unreachable with kn, ks
    alone: the stage reports ``reachable = false`` and keeps the closest point (residuals scaled by
    ``rtol_modulus``·E and ``atol_poisson``).
-2. **σt ← spring tensile strength T** (Brazilian runs): 1-D secant (``scipy.optimize.root_scalar``,
-   method 'secant'), first step from σt ∝ T.
+2. **σt ← spring tensile strength T** (Brazilian runs): 1-D safeguarded secant on ln T ↔ ln σt
+   (:func:`fit_scalar`), first step from σt ∝ T.
 3. **UCS ← cohesion c** at fixed friction angle φ (UCS runs), the same secant. One UCS value cannot
    separate c from φ (a triaxial test would): φ is held at ``[fit] friction_angle`` (or the
    scenario's) and reported.
@@ -56,10 +56,6 @@ MICRO_KEYS = ("kn", "ks", "tensile_strength", "cohesion", "friction_angle")
 
 
 class BudgetExhausted(Exception):
-    pass
-
-
-class _Converged(Exception):
     pass
 
 
@@ -172,7 +168,11 @@ class Lab:
         self._spend()
         t0 = time.perf_counter()
         res = run_brazilian(rock, self.bs, self.braz_mesh, self.seed, self.device)
-        self._record("brazilian", rock, {"sigma_t": res.tensile_strength}, time.perf_counter() - t0)
+        r0 = res.initiation_radius
+        self._record("brazilian", rock, {"sigma_t": res.tensile_strength, "r_over_R": r0}, time.perf_counter() - t0)
+        if not r0 < 0.6:
+            self.log(f"  warning: the first tensile failures lie at r/R = {r0:.2f}: the disc did not split from the "
+                     "centre (mesh too coarse for the loading arc?); σt is not a valid splitting strength")
         return res.tensile_strength
 
     def ucs(self, rock: RockConfig) -> tuple[float, float, float]:
@@ -269,77 +269,105 @@ def fit_elastic(lab: Lab, rock: RockConfig, cfg: FitConfig, report: dict) -> Roc
     return rock
 
 
+MAX_STEP = 3.0          # a secant step changes a strength by at most this factor
+MIN_RESPONSE = 0.1      # |d ln(macro)/d ln(micro)| below this: the macro value does not respond
+
+
 def fit_scalar(evaluate, x0: float, target: float, rtol: float, max_evals: int,
-               f_x0: float | None = None) -> tuple[float, float, list]:
-    """Solve evaluate(x) = target for x > 0 by the secant method (scipy root_scalar), first step
-    x1 = x0·target/evaluate(x0) (response ∝ x). ``f_x0``: evaluate(x0) if already known (no run).
+               f_x0: float | None = None, log=print, label: str = "") -> tuple[float, float, list]:
+    """Solve evaluate(x) = target for x > 0: secant on ln x ↔ ln y (exact for a power law y ∝ x^a),
+    first step with a = 1 (response ∝ x), each step limited to a factor MAX_STEP, and regula falsi
+    once the root is bracketed. Stops when |y − target| ≤ rtol·target, after ``max_evals``
+    evaluations, or when the response is flat (|a| < MIN_RESPONSE: e.g. a coarse disc that fails at
+    the jaws whatever its tensile strength). ``f_x0``: evaluate(x0) if already known (no run).
     Returns (best x, its value, [(x, value), ...])."""
-    from scipy.optimize import root_scalar
-
-    seen: dict[float, float] = {} if f_x0 is None else {float(x0): float(f_x0)}
-
-    def f(x):
-        x = float(max(x, 1e-3 * x0))
-        if x not in seen:
-            if len(seen) >= max_evals:
-                raise BudgetExhausted("stage iterations used up")
-            seen[x] = evaluate(x)
-        if abs(seen[x] - target) <= rtol * target:
-            raise _Converged
-        return seen[x] - target
-
-    try:
-        f0 = f(x0) + target
-        x1 = x0 * target / f0 if f0 > 0 else 2 * x0
-        root_scalar(f, method="secant", x0=x0, x1=x1, xtol=1e-6 * x0, maxiter=max_evals)
-    except (_Converged, ValueError, RuntimeError):
-        pass
-    except BudgetExhausted:
-        if not seen:
-            raise
-    if not seen:
-        raise BudgetExhausted("no evaluation possible")
-    best = min(seen, key=lambda x: abs(seen[x] - target))
-    return best, seen[best], sorted(seen.items())
+    pts: list[tuple[float, float]] = []
+    if f_x0 is not None:
+        pts.append((float(x0), float(f_x0)))
+    lt = math.log(target)
+    x, n_eval = float(x0), 0
+    while True:
+        if not pts or pts[-1][0] != x:
+            if n_eval >= max_evals:
+                break
+            try:
+                y = float(evaluate(x))
+            except BudgetExhausted:
+                if not pts:
+                    raise
+                break
+            pts.append((x, y))
+            n_eval += 1
+        y = pts[-1][1]
+        if abs(y - target) <= rtol * target or not y > 0:
+            break
+        below = [p for p in pts if p[1] < target]
+        above = [p for p in pts if p[1] > target]
+        if len(pts) == 1:
+            (xb, yb), a = pts[-1], 1.0
+        else:
+            if below and above:      # bracketed: regula falsi between the closest points on each side
+                (xa, ya), (xb, yb) = max(below, key=lambda p: p[1]), min(above, key=lambda p: p[1])
+            else:
+                (xa, ya), (xb, yb) = pts[-2], pts[-1]
+            a = (math.log(yb) - math.log(ya)) / (math.log(xb) - math.log(xa)) if xb != xa else 0.0
+            if abs(a) < MIN_RESPONSE:
+                log(f"  {label}: the response is flat (d ln y/d ln x = {a:.3f}); stopping this stage")
+                break
+        x_new = xb * math.exp((lt - math.log(yb)) / a)
+        x = min(max(x_new, pts[-1][0] / MAX_STEP), pts[-1][0] * MAX_STEP)
+    best = min(pts, key=lambda p: abs(p[1] - target))
+    return best[0], best[1], sorted(pts)
 
 
 def fit_strengths(lab: Lab, rock: RockConfig, cfg: FitConfig, achieved: dict) -> tuple[RockConfig, dict]:
-    """Stages 2–4 on one lab: T ← σt, c ← UCS, Brazilian check; repeated up to ``strength_rounds``."""
+    """Stages 2–4 on one lab: T ← σt, c ← UCS, Brazilian check; repeated up to ``strength_rounds``.
+    If the budget runs out, the best point so far is kept and the stage dict gets ``stopped``."""
     tt, tu = cfg.targets.get("tensile_strength"), cfg.targets.get("ucs")
     rounds: list = []
     known_st = None            # σt at the current (T, c), when measured
-    for rnd in range(max(1, cfg.strength_rounds)):
-        row: dict = {}
-        if tt is not None:
-            x, val, pts = fit_scalar(lambda T: lab.brazilian(_with(rock, tensile_strength=T)),
-                                     rock.tensile_strength, tt, cfg.rtol_strength, cfg.strength_iterations, known_st)
-            rock = _with(rock, tensile_strength=x)
-            achieved["tensile_strength"] = known_st = val
-            row["tensile"] = pts
-        if tu is not None:
-            last: dict = {}
+    stopped = None
+    try:
+        for _ in range(max(1, cfg.strength_rounds)):
+            row: dict = {}
+            rounds.append(row)
+            if tt is not None:
+                x, val, pts = fit_scalar(lambda T: lab.brazilian(_with(rock, tensile_strength=T)),
+                                         rock.tensile_strength, tt, cfg.rtol_strength, cfg.strength_iterations,
+                                         known_st, lab.log, "σt ← T")
+                rock = _with(rock, tensile_strength=x)
+                achieved["tensile_strength"] = known_st = val
+                row["tensile"] = pts
+            if tu is not None:
+                last: dict = {}
 
-            def ucs_of(c):
-                u, E, nu = lab.ucs(_with(rock, cohesion=c))
-                last[c] = (E, nu)
-                return u
+                def ucs_of(c):
+                    u, E, nu = lab.ucs(_with(rock, cohesion=c))
+                    last[c] = (E, nu)
+                    return u
 
-            x, val, pts = fit_scalar(ucs_of, rock.cohesion, tu, cfg.rtol_strength, cfg.strength_iterations)
-            moved = x != rock.cohesion
-            rock = _with(rock, cohesion=x)
-            achieved["ucs"] = val
-            achieved["youngs_modulus_run"], achieved["poisson_ratio_run"] = last[x]
-            row["ucs"] = pts
-            if tt is not None and moved:
-                known_st = lab.brazilian(rock)
-                achieved["tensile_strength"] = known_st
-                row["check_tensile"] = known_st
-        rounds.append(row)
-        if tt is None or tu is None or abs(achieved["tensile_strength"] - tt) <= cfg.rtol_strength * tt:
-            break
-    return rock, {"mesh": lab.name, "ucs_mesh_size": lab.ucs_mesh, "brazilian_mesh_size": lab.braz_mesh,
-                  "rounds": rounds, "fitted": {"tensile_strength": rock.tensile_strength, "cohesion": rock.cohesion},
-                  "achieved": {k: achieved.get(k) for k in ("tensile_strength", "ucs")}}
+                x, val, pts = fit_scalar(ucs_of, rock.cohesion, tu, cfg.rtol_strength, cfg.strength_iterations,
+                                         None, lab.log, "UCS ← c")
+                moved = x != rock.cohesion
+                rock = _with(rock, cohesion=x)
+                achieved["ucs"] = val
+                achieved["youngs_modulus_run"], achieved["poisson_ratio_run"] = last[x]
+                row["ucs"] = pts
+                if tt is not None and moved:
+                    achieved.pop("tensile_strength", None)      # c moved: σt at (T, c) is unknown until measured
+                    known_st = lab.brazilian(rock)
+                    achieved["tensile_strength"] = known_st
+                    row["check_tensile"] = known_st
+            if tt is None or tu is None or abs(achieved["tensile_strength"] - tt) <= cfg.rtol_strength * tt:
+                break
+    except BudgetExhausted as e:
+        stopped = str(e)
+    out = {"mesh": lab.name, "ucs_mesh_size": lab.ucs_mesh, "brazilian_mesh_size": lab.braz_mesh,
+           "rounds": rounds, "fitted": {"tensile_strength": rock.tensile_strength, "cohesion": rock.cohesion},
+           "achieved": {k: achieved.get(k) for k in ("tensile_strength", "ucs")}}
+    if stopped:
+        out["stopped"] = stopped
+    return rock, out
 
 
 def fit(rock: RockConfig, cfg: FitConfig, lab: Lab, search: Lab | None = None, refine: bool = True) -> dict:
@@ -372,6 +400,9 @@ def fit(rock: RockConfig, cfg: FitConfig, lab: Lab, search: Lab | None = None, r
             stages.append(st)
             if lb is labs[-1]:
                 achieved.update(ach)
+            if "stopped" in st:
+                report["stopped"] = f"{st['stopped']} (on the {lb.name} meshes)"
+                break
     except BudgetExhausted as e:
         report["stopped"] = str(e)
     report["strength_stages"] = stages

@@ -8,10 +8,10 @@ specimens (docs/calibration.md, examples/calibration/README.md).
 Why not Cundall local damping α = 0.8 (METHOD §1.6)? Its force −α|f|·sign(v) opposes the *motion*
 of every node that carries an unbalanced force, also the steady motion of a specimen that is
 being compressed; the platens then push against that drag as well as against the specimen. Measured
-on the coarse prism with the paper's springs: E' 53.3 GPa at 0.1 m/s and 52.7 at 0.025 m/s against
-51.63 GPa from the exact static solve (:func:`.elastic.static_moduli`), and a Brazilian σt that
-falls 10 % when the speed is halved; with α = 0 the same runs give 51.68 GPa and +0.2 %. α is
-still a setting (``damping``) for comparisons.
+on the coarse prism with the paper's springs: E' 53.15 GPa at 0.1 m/s and 52.96 at 0.025 m/s against
+51.63 GPa from the exact static solve (:func:`.elastic.static_moduli`) and 52.08 GPa for the blocks
+alone, and a coarse-disc σt that falls 18 % when 0.1 m/s is halved; with α = 0 the same runs give
+51.68 GPa and +0.2 %. α is still a setting (``damping``) for comparisons.
 Samples of the platen reactions and the specimen's node displacements are taken every
 ``sample_strain`` of nominal strain (platen closure / specimen height); the run stops once
 the load has dropped below ``stop_drop`` × peak after the peak, or at ``max_strain``.
@@ -100,6 +100,8 @@ class LoadResult:
     x_final: np.ndarray
     pair_mode: np.ndarray
     pair_tbreak: np.ndarray
+    pair_mode_failure: np.ndarray | None = None   # spring modes at the sample that declared failure
+    failure_index: int | None = None              # that sample's index
 
 
 def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
@@ -131,6 +133,7 @@ def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
     groups = {k: getattr(spec, k) for k in ("top", "bottom", "left", "right")}
     hist, peak, stopped = LoadHistory(), 0.0, "max_strain"
     u_peak, failed = 0.0, False
+    mode_failure, i_failure = None, None
     t, wall0 = 0.0, time.perf_counter()
     step = 0
     for step in range(1, max_steps + 1):
@@ -159,7 +162,8 @@ def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
             continue
         if load > peak and not failed:
             peak, u_peak = load, hist.platen_u[-1]
-        failed = failed or (peak > 0 and load < (1.0 - s.failure_drop) * peak)
+        if not failed and peak > 0 and load < (1.0 - s.failure_drop) * peak:
+            failed, mode_failure, i_failure = True, mode.copy(), len(hist.time) - 1
         if failed and load < s.stop_drop * peak:
             stopped = "post_peak_drop"
             break
@@ -170,7 +174,8 @@ def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
             stopped = "non_finite"
             break
     return LoadResult(hist, step, dt, time.perf_counter() - wall0, stopped, t_ramp,
-                      st.x.numpy().copy(), st.pair_mode.numpy().copy(), st.pair_tbreak.numpy().copy())
+                      st.x.numpy().copy(), st.pair_mode.numpy().copy(), st.pair_tbreak.numpy().copy(),
+                      mode_failure, i_failure)
 
 
 def run_start(run: LoadResult) -> int:

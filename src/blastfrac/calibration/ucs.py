@@ -12,7 +12,7 @@ Outputs (2D plane strain, unit thickness):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -36,6 +36,7 @@ class UCSResult:
     youngs_modulus: float         # 3D-equivalent E [Pa]
     poisson_ratio: float          # 3D-equivalent ν [-]
     ucs: float                    # [Pa]
+    reference: dict = field(default_factory=dict)   # elastic references of the same prism, see elastic_reference
 
     @property
     def max_stress(self) -> float:
@@ -60,6 +61,7 @@ class UCSResult:
             "mesh_size_m": self.specimen.scenario.geometry.mesh_size,
             "time_step_s": self.run.dt, "steps": self.run.steps, "wall_s": self.run.wall_s,
             "stopped": self.run.stopped,
+            "elastic_reference": self.reference,
         }
 
 
@@ -95,9 +97,33 @@ def dilation_onset(strain: np.ndarray, lateral: np.ndarray, start: int = 0, wind
     return None
 
 
+def elastic_reference(spec: Specimen) -> dict:
+    """Plane-strain E' [Pa], ν' of the prism: blocks alone, the analytic estimate of METHOD §1.2 and the
+    exact linear static solve of this mesh (the zero-speed limit of the test's elastic part)."""
+    from .curves import three_d_to_plane_strain
+    from .elastic import edge_density, effective_moduli, static_moduli
+
+    rock = spec.scenario.rock
+    out = {"blocks": dict(zip(("youngs_modulus_ps", "poisson_ratio_ps"),
+                              three_d_to_plane_strain(rock.youngs_modulus, rock.poisson_ratio))),
+           "unit": "Pa, -"}
+    if rock.stiffness_mode == "per_area":
+        ell = edge_density(spec.model)
+        Ep, nup = three_d_to_plane_strain(*effective_moduli(rock.youngs_modulus, rock.poisson_ratio, ell,
+                                                            rock.kn, rock.ks))
+        out["analytic"] = {"youngs_modulus_ps": Ep, "poisson_ratio_ps": nup, "edge_density_per_m": ell}
+    Ep, nup = static_moduli(spec)
+    out["static"] = {"youngs_modulus_ps": Ep, "poisson_ratio_ps": nup}
+    return out
+
+
 def run_ucs(rock: RockConfig, settings: LoadSettings | None = None, mesh_size: float | None = None,
-            seed: int = 0, device: str = "cpu", on_sample=None) -> UCSResult:
-    """Build the 54 × 108 mm prism for ``rock``, load it to failure and read the curve."""
+            seed: int = 0, device: str = "cpu", on_sample=None, reference: bool = False) -> UCSResult:
+    """Build the 54 × 108 mm prism for ``rock``, load it to failure and read the curve.
+    ``reference``: also compute :func:`elastic_reference` (one sparse solve, about 1 s)."""
     settings = settings or LoadSettings()
     spec = ucs_specimen(rock, mesh_size, seed, device)
-    return analyse_ucs(spec, run_loading(spec, settings, on_sample), settings)
+    res = analyse_ucs(spec, run_loading(spec, settings, on_sample), settings)
+    if reference:
+        res.reference = elastic_reference(spec)
+    return res

@@ -28,7 +28,7 @@ def add_parser(sub) -> None:
                    help="element size of both specimens [m] (default: sizes giving the paper's 3734/2167 elements)")
     p.add_argument("--ucs-mesh-size", type=float, default=None, metavar="H", help="element size of the UCS prism [m]")
     p.add_argument("--brazilian-mesh-size", type=float, default=None, metavar="H", help="element size of the disc [m]")
-    p.add_argument("--speed", type=float, default=None, help="platen speed, each platen [m/s] (default 0.025)")
+    p.add_argument("--speed", type=float, default=None, help="platen speed, each platen [m/s] (default 0.05)")
     p.add_argument("--damping", type=float, default=None, help="Cundall local damping α (default 0: undamped, see docs)")
     p.add_argument("--platens", choices=("frictionless", "bonded"), default="frictionless",
                    help="UCS platen condition: free lateral slip (default) or no-slip")
@@ -117,10 +117,14 @@ def run(args) -> int:
         rock, extra["fit"] = _fit(args, rock, us, bs, hu, hb, seed, dev, out)
     ucs = braz = None
     if args.only != "brazilian":
-        ucs = prog.run("UCS test", run_ucs, rock, us, hu, seed, dev)
+        ucs = prog.run("UCS test", run_ucs, rock, us, hu, seed, dev, reference=True)
         print(f"UCS test ({ucs.specimen.element_count} elements, {ucs.run.steps} steps, {ucs.run.wall_s:.0f} s): "
               f"E = {ucs.youngs_modulus / 1e9:.2f} GPa, ν = {ucs.poisson_ratio:.3f} (plane strain E' = "
               f"{ucs.youngs_modulus_ps / 1e9:.2f} GPa, ν' = {ucs.poisson_ratio_ps:.3f}), UCS = {ucs.ucs / 1e6:.1f} MPa")
+        ref = ucs.reference
+        print("  elastic references, plane strain: " + ", ".join(
+            f"{k} E' = {ref[k]['youngs_modulus_ps'] / 1e9:.2f} GPa, ν' = {ref[k]['poisson_ratio_ps']:.3f}"
+            for k in ("blocks", "analytic", "static") if k in ref))
     if args.only != "ucs":
         braz = prog.run("Brazilian test", run_brazilian, rock, bs, hb, seed, dev)
         print(f"Brazilian test ({braz.specimen.element_count} elements, {braz.run.steps} steps, "
@@ -128,7 +132,8 @@ def run(args) -> int:
               f"median r/R = {braz.initiation_radius:.2f}")
     if args.check_speed:
         extra["speed_check"] = _speed_check(prog, rock, us, bs, hu, hb, seed, dev, ucs, braz)
-    data = write_report(out, rock, ucs, braz, extra, figures=not args.no_figures, title=sc.title)
+    title = sc.title + (" — fitted micro-parameters" if args.fit else "")
+    data = write_report(out, rock, ucs, braz, extra, figures=not args.no_figures, title=title)
     print(f"results in {out}/calibration.json" + ("" if args.no_figures else " (+ stress_strain.png, failed_specimens.png)"))
     if "speed_check" in data:
         for k, v in data["speed_check"].items():
