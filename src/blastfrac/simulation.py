@@ -239,7 +239,7 @@ class Simulation:
         summary = self.summary(wall)
         write_summary(self.out_dir / "summary.json", summary)
         if sc.output.figures:
-            self.write_figures(mon, frac, energy)
+            self.write_figures(mon, frac, energy, cracks=summary["cracks"])
         return summary
 
     def energies(self) -> dict[str, float]:
@@ -326,7 +326,7 @@ class Simulation:
         mode = self.state.pair_mode.numpy()
         return [crack_statistics(self.model, mode, np.asarray(c, float), r) for c, r in centres]
 
-    def write_figures(self, mon: CsvHistory, frac: CsvHistory, energy: CsvHistory) -> None:
+    def write_figures(self, mon: CsvHistory, frac: CsvHistory, energy: CsvHistory, cracks: list[dict] | None = None) -> None:
         from .plot import figures
 
         x = self.state.x.numpy()
@@ -345,6 +345,10 @@ class Simulation:
             f = self.gas.particle_fields()
             figures.gas_particles(self.out_dir / "gas_pressure.png", f["position"], f["pressure"], x, seg, cmode,
                                   title=f"{title}: gas pressure at t = {self.time * 1e6:.1f} µs")
+        cracks = self.crack_statistics() if cracks is None else cracks
+        if cracks:
+            figures.crack_profile(self.out_dir / "crack_profile.png", cracks,
+                                  title=f"{title}: cracks crossing circles about the hole (dotted: r_c)")
         t = np.array([r[0] for r in frac.rows])
         figures.fracture_degree_zones(self.out_dir / "fracture_degree.png", t,
                                       {k: frac.column(k) for k in frac.columns[1:]}, title=f"{title}: fracture degree")

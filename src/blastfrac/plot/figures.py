@@ -182,3 +182,33 @@ def fracture_degree_zones(path: Path, t: np.ndarray, cols: dict[str, np.ndarray]
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
+    """Radial cracks crossing circles about each hole, N(R), and the shattered fraction of each circle.
+
+    ``stats``: the entries of summary.json → cracks (analysis.cracks.crack_statistics), one per hole.
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4), dpi=150)
+    ax2 = ax.twinx()
+    for i, s in enumerate(stats):
+        p = s["crossings"]
+        R = np.asarray(p["radius"]) / s["borehole_radius"]
+        lab = f" (hole {i})" if len(stats) > 1 else ""
+        ax.plot(R, p["count"], color="k", label=f"all cracks{lab}")
+        ax.plot(R, p["count_tensile"], color=TENSILE_COLOR, ls="--", label=f"tensile{lab}")
+        frac = np.asarray(p["shattered_arc"]) / (2 * np.pi * np.asarray(p["radius"]))
+        ax2.fill_between(R, 0, np.minimum(frac, 1.0), color="0.6", alpha=0.3, lw=0)
+        ax.axvline(s["crushed_zone_radius_over_rb"], color=SHEAR_COLOR, lw=0.8, ls=":")
+    ax.set_xlabel("radius R / r_b [-]")
+    ax.set_ylabel("cracks crossing the circle R [-]")
+    ax2.set_ylabel("shattered fraction of the circle (grey) [-]")
+    ax2.set_ylim(0, 1)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title(title or "Radial cracks (dotted: crushed-zone radius)", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
