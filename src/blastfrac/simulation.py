@@ -41,10 +41,10 @@ class Simulation:
         self.builder = ModelBuilder(scenario, mesh)
         self.model = self.builder.finalize(self.device)
         self.state = self.model.state()
-        # Node-to-edge block contact (cdem/contact.py) is switched off: its kernel produces spurious forces on
-        # first contact (tests/verification/test_block_contact.py, xfail). Broken springs still act as
-        # unilateral frictional contacts until they separate.
-        self.cdem = CDEMSolver(self.model, block_contact=False)
+        # Node-to-edge block contact between separated blocks (cdem/contact.py, METHOD §1.5) is on whenever the
+        # springs can break (rock.block_contact); broken springs that have not separated act as unilateral
+        # frictional contacts.
+        self.cdem = CDEMSolver(self.model, block_contact=scenario.rock.block_contact and self.model.breakable == 1)
         self.gas = None
         self.coupler = None
         self.gas_report: dict = {}
