@@ -165,13 +165,25 @@ class Simulation:
         e = rock_energies(self.model, self.state)
         self.initial_stored = e["strain"] + e["springs"]
         counts = self.fracture.counts(mode)
+        # intact springs already on their softening branch (fracture energies given): damaged, not broken
+        s_now, h = self.state.pair_str.numpy(), self.model.host
+        softening = (mode == 0) & ((s_now[:, 0] < h["pair_t0"] * (1 - 1e-9)) | (s_now[:, 1] < h["pair_c0"] * (1 - 1e-9)))
         self.insitu_report = {
             "method": ins.method, "steps": steps, "pseudo_time": t_relax, "converged": bool(converged),
             "kinetic_to_strain_ratio": ratio, "broken_tensile": counts["tensile"], "broken_shear": counts["shear"],
-            "failures_allowed": ins.allow_failure,
+            "softening": int(softening.sum()), "failures_allowed": ins.allow_failure, "wall_check": self._kirsch_check(),
         }
         self.time, self.steps = 0.0, 0
         return self.insitu_report
+
+    def _kirsch_check(self) -> list[dict]:
+        """Hoop stress on each borehole wall after the in-situ stage against Kirsch (analysis.insitu)."""
+        from .analysis.insitu import wall_stress_check
+
+        ins, rock = self.scenario.insitu, self.scenario.rock
+        x, sig = self.state.x.numpy(), self.state.sigma.numpy()
+        return [wall_stress_check(x, sig, b.center, b.radius, ins.sxx, ins.syy, ins.sxy, rock.tensile_strength)
+                for b in self.scenario.geometry.boreholes]
 
     # ------------------------------------------------------------------ run loop
     def run(self, progress: bool | None = None) -> dict:

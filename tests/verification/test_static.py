@@ -87,3 +87,10 @@ def test_kirsch_hole_under_far_field_stress(tmp_path):
           f"{np.mean(crown) / 1e6:.2f} MPa (Kirsch at the wall +{S / 1e6:.0f}), side {np.mean(side) / 1e6:.2f} MPa (−{3 * S / 1e6:.0f})")
     assert max(errs) < 0.05
     assert np.mean(crown) > 0.6 * S       # tension at the crown: the paper's pre-stress pitfall
+    # the stage's own wall report (summary.json → insitu_stage.wall_check) says the same
+    wc = rep["wall_check"][0]
+    print(f"wall check: {wc}")
+    assert wc["kirsch_max_tension_at_wall"] == pytest.approx(S, rel=1e-12)    # +S at the crown of a free hole
+    assert wc["kirsch_max_tension_at_block_centroids"] < S
+    assert abs(wc["hoop_max_tension"] - wc["kirsch_max_tension_at_block_centroids"]) < 0.1 * S
+    assert wc["hoop_rms_difference"] < 0.05 * 3 * S
