@@ -12,7 +12,9 @@ def add_parser(sub) -> None:
     p.add_argument("--device", default="cpu", help="cpu, cuda or cuda:N")
     p.add_argument("--steps", type=int, default=20, help="timed steps per size")
     p.add_argument("--quick", action="store_true", help="small sizes only (smoke run)")
-    p.add_argument("--only", choices=("cdem", "mpm"), default=None)
+    p.add_argument("--only", choices=("cdem", "mpm", "examples"), default=None,
+                   help="one suite; default: cdem and mpm ('examples' runs the paper's examples at full resolution, "
+                   "minutes)")
     p.set_defaults(func=run)
 
 
@@ -52,5 +54,9 @@ def run(args) -> int:
         for r in rows:
             print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['particle_steps_per_s']:.3e} |")
         print(f"scaling slope: {_load('bench_cdem').scaling_slope(rows, 'n_particles'):.3f}")
+    if args.only == "examples":
+        ex = _load("bench_examples")
+        rows = ex.run(device=device)
+        print(ex.markdown(rows, device))
     sys.stdout.flush()
     return 0
