@@ -29,6 +29,7 @@ def p2g(
     vol: wp.array(dtype=wp.float64),
     stress: wp.array(dtype=wp.mat22d),
     f_ext: wp.array(dtype=wp.vec2d),
+    f_ext_moment: wp.array(dtype=wp.mat22d),
     active: wp.array(dtype=wp.int32),
     x0: wp.float64,
     y0: wp.float64,
@@ -43,7 +44,11 @@ def p2g(
     g_mom: wp.array(dtype=wp.vec2d),
     g_force: wp.array(dtype=wp.vec2d),
 ):
-    """m_I += N m_p; p_I += N m_p v_p; f_I += -V_p sigma_p grad N + N f_ext_p (all per unit thickness)."""
+    """m_I += N m_p; p_I += N m_p v_p; f_I += -V_p sigma_p grad N + N f_ext_p + M_p grad N (per unit thickness).
+
+    M_p = Σ_k f_k ⊗ (x_k − x_p) [N] is the first moment of the external forces f_k that act at points x_k other
+    than the particle centre (contact tractions on the particle's surface): N_I(x_k) ≈ N_I(x_p) + ∇N_I·(x_k − x_p).
+    """
     p = wp.tid()
     if active[p] == 0:
         return
@@ -52,6 +57,7 @@ def p2g(
     mv = m * v[p]
     vs = vol[p] * stress[p]
     fe = f_ext[p]
+    ms = f_ext_moment[p] - vs
     for i in range(3):
         ii = wrap_index(bx + i, nx, px)
         for j in range(3):
@@ -60,7 +66,7 @@ def p2g(
             grad = wp.vec2d(dwx[i] * wy[j] * inv_h, wx[i] * dwy[j] * inv_h)
             wp.atomic_add(g_mass, n, N * m)
             wp.atomic_add(g_mom, n, N * mv)
-            wp.atomic_add(g_force, n, N * fe - vs * grad)
+            wp.atomic_add(g_force, n, N * fe + ms * grad)
 
 
 @wp.kernel

@@ -74,7 +74,8 @@ def grid_from_config(config) -> GridSpec:
 class MPMSolver:
     """Explicit MUSL MPM for JWL detonation products (or a linear-elastic solid, for tests).
 
-    Particle arrays (shape [n]): x, v, v_pic [m/s], f_ext_p [N/m] (vec2d); mass [kg/m];
+    Particle arrays (shape [n]): x, v, v_pic [m/s], f_ext_p [N/m] (vec2d); f_ext_moment [N] (mat22d: first
+    moment Σ f ⊗ (x_f − x_p) of external forces applied off the particle centre, see ``p2g``); mass [kg/m];
     vol, vol0, vol_prev [m^2]; rho [kg/m^3]; ie [J/m] (JWL internal energy; elastic solid: the work
     done on it); p, q [Pa]; burn [-]; light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32).
     Grid arrays: ``self.grid`` (:class:`Grid`).
@@ -151,6 +152,7 @@ class MPMSolver:
         self.x = wp.array(x, dtype=wp.vec2d, device=d)
         self.v = wp.array(np.zeros((n, 2)) if v is None else np.asarray(v, F64), dtype=wp.vec2d, device=d)
         self.v_pic, self.f_ext_p = z(wp.vec2d), z(wp.vec2d)
+        self.f_ext_moment = z(wp.mat22d)
         self.mass = wp.array(rho0 * vol, dtype=wp.float64, device=d)
         self.vol = wp.array(vol, dtype=wp.float64, device=d)
         self.vol0 = wp.array(vol, dtype=wp.float64, device=d)
@@ -217,7 +219,8 @@ class MPMSolver:
         wp.launch(
             p2g,
             dim=self.n,
-            inputs=[self.x, self.v, self.mass, self.vol, self.stress, self.f_ext_p, self.active, *self._geo_f()],
+            inputs=[self.x, self.v, self.mass, self.vol, self.stress, self.f_ext_p, self.f_ext_moment, self.active,
+                    *self._geo_f()],
             outputs=[g.mass, g.mom, g.force],
             device=self.device,
         )
