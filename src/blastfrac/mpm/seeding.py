@@ -1,10 +1,21 @@
 """Material-point seeding of charge regions (circles, polygons; any number).
 
-Points sit on a regular sub-lattice of the grid, ``ppc`` per cell per direction, at the
-sub-cell centres; a point belongs to the first charge containing it.  Each point starts
-with volume (h/ppc)^2 [m^2 per unit thickness]; with ``exact_area`` the volumes of a
-charge are scaled so that they add up to the charge's exact area (mass and chemical
-energy per unit thickness are then exact).
+Two layouts, both with point spacing s = h/ppc (``ppc`` points per cell per direction):
+
+* ``lattice``: points on a regular sub-lattice of the grid, at the sub-cell centres. Each point
+  starts with volume s^2 [m^2 per unit thickness]; with ``exact_area`` the volumes of a charge are
+  scaled so that they add up to the charge's exact area (mass and chemical energy per unit
+  thickness are then exact).  Along a curved boundary the lattice leaves a ragged void up to one
+  spacing wide between the outermost points and the circle.
+* ``conformal`` (circles only; polygons fall back to the lattice): concentric rings of width s
+  laid from the circle inwards around a small core; each ring holds round(2π r_m/s) points of
+  equal volume (the ring's area shared out, so the charge area is exact) at its mid radius r_m,
+  every other ring rotated by half a pitch.  A point's radius ½√V_p is then s/2, so the outer
+  ring touches the circle: a charge that fills a borehole leaves no void at its wall (a void lets
+  the products accelerate across it and strike the wall well above their pressure).
+
+A point belongs to the first charge containing it (later charges drop the points that fall inside
+earlier ones).
 """
 
 from __future__ import annotations
@@ -59,13 +70,75 @@ def charge_area_centroid(charge) -> tuple[float, np.ndarray]:
     return polygon_area_centroid(np.asarray(d["vertices"], float))
 
 
-def seed_charges(charges, spec, ppc: int, exact_area: bool = True):
-    """Seed points in the charges on grid ``spec``; returns (x [n,2] m, vol [n] m^2, charge_id [n])."""
+SEEDING_MODES = ("conformal", "lattice")
+
+
+def charge_contains(charge, pts: np.ndarray) -> np.ndarray:
+    """True where pts [n,2] lie inside the charge (circle: strictly; polygon: even-odd rule)."""
+    kind, d = charge_geometry(charge)
+    if kind == "circle":
+        return np.linalg.norm(pts - np.asarray(d["center"], float), axis=1) < d["radius"]
+    return points_in_polygon(pts, np.asarray(d["vertices"], float))
+
+
+def circle_rings(center, radius: float, spacing: float) -> tuple[np.ndarray, np.ndarray]:
+    """Conformal points of a disk [m]: (x [n,2] m, vol [n] m^2), see the module docstring.
+
+    Rings of width s = ``spacing`` from the circle inwards, K = floor((R − s/√π)/s) of them, ring i
+    between R − (i+1)s and R − is with n_i = max(3, round(2π r_m/s)) equal points at its mid radius r_m;
+    the core disk left over (radius between s/√π and s(1 + 1/√π)) holds round(area/s²) points: one at
+    the centre if that is at most 2, else equal sectors with the points at their centroids. The outer
+    ring's points are s/2 from the circle and their radius ½√V_p is s/2 within the rounding of n_i.
+    """
+    c = np.asarray(center, float)
+    R, s = float(radius), float(spacing)
+    K = max(0, int(np.floor((R - s / np.sqrt(np.pi)) / s)))
+    rc = R - K * s
+    xs, vs = [], []
+    nc = int(round(np.pi * rc * rc / (s * s)))
+    if nc <= 2:
+        xs.append(c[None, :])
+        vs.append(np.array([np.pi * rc * rc]))
+    else:
+        half = np.pi / nc                                    # sector half-angle
+        rg = (2.0 / 3.0) * rc * np.sin(half) / half          # sector centroid radius
+        th = np.arange(nc) * 2.0 * half
+        xs.append(c + rg * np.stack([np.cos(th), np.sin(th)], axis=1))
+        vs.append(np.full(nc, np.pi * rc * rc / nc))
+    for i in range(K):                                       # from the core outwards
+        ra, rb = rc + i * s, rc + (i + 1) * s
+        rm = 0.5 * (ra + rb)
+        n = max(3, int(round(2.0 * np.pi * rm / s)))
+        th = (np.arange(n) + 0.5 * ((K - i) % 2)) * (2.0 * np.pi / n)
+        xs.append(c + rm * np.stack([np.cos(th), np.sin(th)], axis=1))
+        vs.append(np.full(n, np.pi * (rb * rb - ra * ra) / n))
+    return np.concatenate(xs), np.concatenate(vs)
+
+
+def seed_charges(charges, spec, ppc: int, exact_area: bool = True, mode: str = "lattice"):
+    """Seed points in the charges on grid ``spec``; returns (x [n,2] m, vol [n] m^2, charge_id [n]).
+
+    mode: ``lattice`` (all charges on the grid sub-lattice) or ``conformal`` (circles on rings, polygons on
+    the lattice); see the module docstring.
+    """
+    if mode not in SEEDING_MODES:
+        raise ValueError(f"unknown seeding mode '{mode}'; expected one of {SEEDING_MODES}")
     h = spec.h
     dx = h / ppc
     xs_all, vol_all, cid_all = [], [], []
     taken = None
     for k, ch in enumerate(charges):
+        kind, d = charge_geometry(ch)
+        if mode == "conformal" and kind == "circle":
+            pts, vol = circle_rings(d["center"], d["radius"], dx)
+            new = np.ones(len(pts), bool)
+            for j in range(k):
+                new &= ~charge_contains(charges[j], pts)
+            pts, vol = pts[new], vol[new]
+            xs_all.append(pts)
+            vol_all.append(vol)
+            cid_all.append(np.full(len(pts), k, dtype=np.int32))
+            continue
         lo, hi = charge_bbox(ch)
         i0 = int(np.floor((lo[0] - spec.x0) / dx)) - 1
         i1 = int(np.ceil((hi[0] - spec.x0) / dx)) + 1
@@ -73,12 +146,10 @@ def seed_charges(charges, spec, ppc: int, exact_area: bool = True):
         j1 = int(np.ceil((hi[1] - spec.y0) / dx)) + 1
         I, J = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1), indexing="xy")
         pts = np.stack([spec.x0 + (I.ravel() + 0.5) * dx, spec.y0 + (J.ravel() + 0.5) * dx], axis=1)
-        kind, d = charge_geometry(ch)
-        if kind == "circle":
-            inside = np.linalg.norm(pts - np.asarray(d["center"], float), axis=1) < d["radius"]
-        else:
-            inside = points_in_polygon(pts, np.asarray(d["vertices"], float))
-        pts = pts[inside]
+        pts = pts[charge_contains(ch, pts)]
+        for j in range(k):                                   # earlier conformal charges are not on the lattice
+            if mode == "conformal" and charge_geometry(charges[j])[0] == "circle":
+                pts = pts[~charge_contains(charges[j], pts)]
         if taken is not None and len(pts):
             key = np.round((pts - [spec.x0, spec.y0]) / dx - 0.5).astype(np.int64)
             keys = key[:, 0] * 1_000_003 + key[:, 1]

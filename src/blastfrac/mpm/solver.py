@@ -100,7 +100,7 @@ class MPMSolver:
             p_cj=config.burn.p_cj,
         )
         spec = grid_from_config(config)
-        x, vol, _ = seed_charges(config.charges, spec, opts.ppc)
+        x, vol, _ = seed_charges(config.charges, spec, opts.ppc, mode=config.seeding)
         if particle_filter is not None:
             x, vol = particle_filter(x, vol)
         if config.detonation_points:

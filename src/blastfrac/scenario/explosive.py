@@ -108,6 +108,12 @@ class ExplosiveConfig(_Model):
         default_factory=list, description="initiation points; default: the centroid of each charge, no delay"
     )
     grid: GridConfig = Field(description="background grid")
+    seeding: Literal["conformal", "lattice"] = Field(
+        default="conformal", description="material-point layout: 'conformal' seeds circle charges on concentric rings "
+        "whose outer ring touches the circle (no void between a borehole-filling charge and the wall; polygons use the "
+        "lattice); 'lattice' puts every charge on the grid sub-lattice, which leaves a ragged void up to one point "
+        "spacing wide along a circle"
+    )
     shape: Literal["bspline2", "ugimp"] = Field(
         default="bspline2", description="shape functions: quadratic B-spline or uGIMP (l_p = h/(2 ppc))"
     )
