@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import warp as wp
 
-from .particle_edge import CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap, vertex_overlap
+from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap,
+                            pressure_offset, vertex_overlap)
 
 # slots of the coupling's energy accumulator
-ACC_ABSORBED = 0       # work absorbed by the contacts since the start, ∫ −f·(v_p − v_c) dt [J/m]
-ACC_STORED = 1         # penalty energy ½k_c·δ² stored in the contacts at this step [J/m]
-ACC_CONTACTS = 2       # number of particle–element contacts at this step [-]
+ACC_ABSORBED = wp.constant(0)   # work absorbed by the contacts since the start, −∫(P_gas + P_rock) dt [J/m]
+ACC_STORED = wp.constant(1)     # penalty energy ½k_c·δ² stored in the contacts at this step [J/m]
+ACC_CONTACTS = wp.constant(2)   # number of particle–element contacts at this step [-]
 
 
 @wp.func
@@ -56,6 +57,7 @@ def eval_particle_edge_contact(
     m_rock: wp.array(dtype=wp.float64),
     x_p: wp.array(dtype=wp.vec2d),
     v_p: wp.array(dtype=wp.vec2d),
+    grad_v: wp.array(dtype=wp.mat22d),
     m_p: wp.array(dtype=wp.float64),
     vol_p: wp.array(dtype=wp.float64),
     p_p: wp.array(dtype=wp.float64),
@@ -68,10 +70,14 @@ def eval_particle_edge_contact(
     r_max: wp.float64,
     query_radius: wp.float64,
     dt: wp.float64,
+    surface: wp.float64,
+    preload: wp.float64,
     hist_e_in: wp.array(dtype=wp.int32),
     hist_d_in: wp.array(dtype=wp.float64),
     f_p: wp.array(dtype=wp.vec2d),
+    fm_p: wp.array(dtype=wp.mat22d),
     f_rock: wp.array(dtype=wp.vec2d),
+    f_react: wp.array(dtype=wp.vec2d),
     acc: wp.array(dtype=wp.float64),
     hist_e_out: wp.array(dtype=wp.int32),
     hist_d_out: wp.array(dtype=wp.float64),
@@ -85,17 +91,19 @@ def eval_particle_edge_contact(
     zero = wp.float64(0.0)
     one = wp.float64(1.0)
     fsum = wp.vec2d(zero, zero)
+    msum = wp.mat22d(zero, zero, zero, zero)
     h0 = p * CONTACT_HISTORY
     for h in range(CONTACT_HISTORY):
         hist_e_out[h0 + h] = -1
     if active[p] == 0:
         f_p[p] = fsum
+        fm_p[p] = msum
         return
     xp = x_p[p]
     vp = v_p[p]
     mp = m_p[p]
     rp = wp.min(wp.float64(0.5) * wp.sqrt(vol_p[p]), r_max)
-    diss = wp.float64(0.0)
+    rc = rp + preload * pressure_offset(p_p[p], rp, kc)
     stored = wp.float64(0.0)
     ncon = int(0)
     query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius)
@@ -111,7 +119,7 @@ def eval_particle_edge_contact(
             s = 3 * e + k
             if slot_exposed(s, slot_iface, pair_mode):
                 b = 3 * e + (k + 1) % 3
-                de, ne, xie = edge_overlap(xp, rp, x_rock[s], x_rock[b])
+                de, ne, xie = edge_overlap(xp, rc, x_rock[s], x_rock[b])
                 if de > best:
                     best = de
                     bn = ne
@@ -121,7 +129,7 @@ def eval_particle_edge_contact(
         for k in range(3):
             a = 3 * e + k
             if slot_exposed(a, slot_iface, pair_mode) or slot_exposed(3 * e + (k + 2) % 3, slot_iface, pair_mode):
-                dv, nv = vertex_overlap(xp, rp, x_rock[a])
+                dv, nv = vertex_overlap(xp, rc, x_rock[a])
                 if dv > best:
                     best = dv
                     bn = nv
@@ -133,7 +141,8 @@ def eval_particle_edge_contact(
             mc = wa * m_rock[ia] + bxi * m_rock[ib]
             vc = wa * v_rock[ia] + bxi * v_rock[ib]
             cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
-            vrel = vp - vc
+            arm = -surface * rp * bn                       # contact point (disk surface) − particle centre [m]
+            vrel = vp + grad_v[p] * arm - vc               # gas velocity at the contact point − wall velocity
             # initial overlap δ₀: kept from the last step's contact with e, else what a new contact cannot explain
             d0 = wp.float64(-1.0)
             for h in range(CONTACT_HISTORY):
@@ -150,13 +159,52 @@ def eval_particle_edge_contact(
                 fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
             f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
             fsum = fsum + f
+            msum = msum + wp.outer(f, arm)
             wp.atomic_add(f_rock, ia, -wa * f)
             wp.atomic_add(f_rock, ib, -bxi * f)
-            diss = diss - wp.dot(f, vrel) * dt
+            wp.atomic_add(f_react, ia, -wa * f)
+            wp.atomic_add(f_react, ib, -bxi * f)
             stored = stored + wp.float64(0.5) * kc * best * best
             ncon = ncon + 1
     f_p[p] = fsum
+    fm_p[p] = msum
     if ncon > 0:
-        wp.atomic_add(acc, 0, diss)
-        wp.atomic_add(acc, 1, stored)
-        wp.atomic_add(acc, 2, wp.float64(ncon))
+        wp.atomic_add(acc, ACC_STORED, stored)
+        wp.atomic_add(acc, ACC_CONTACTS, wp.float64(ncon))
+
+
+@wp.kernel
+def accumulate_gas_contact_work(
+    f_p: wp.array(dtype=wp.vec2d),
+    fm_p: wp.array(dtype=wp.mat22d),
+    v_p: wp.array(dtype=wp.vec2d),
+    grad_v: wp.array(dtype=wp.mat22d),
+    active: wp.array(dtype=wp.int32),
+    w: wp.float64,
+    acc: wp.array(dtype=wp.float64),
+):
+    """acc[ABSORBED] −= w·(f·v + M:L) [J/m]: work the contact forces f [N/m], applied with moment M [N] (see
+    mpm.kernels_p2g.p2g), do on the gas moving with velocity v [m/s] and velocity gradient L [1/s] over a time w [s]."""
+    p = wp.tid()
+    if active[p] == 0:
+        return
+    f = f_p[p]
+    M = fm_p[p]
+    L = grad_v[p]
+    pw = wp.dot(f, v_p[p]) + M[0, 0] * L[0, 0] + M[0, 1] * L[0, 1] + M[1, 0] * L[1, 0] + M[1, 1] * L[1, 1]
+    if pw != wp.float64(0.0):
+        wp.atomic_add(acc, ACC_ABSORBED, -w * pw)
+
+
+@wp.kernel
+def accumulate_rock_contact_work(
+    f_react: wp.array(dtype=wp.vec2d),
+    v: wp.array(dtype=wp.vec2d),
+    w: wp.float64,
+    acc: wp.array(dtype=wp.float64),
+):
+    """acc[ABSORBED] −= w·f·v [J/m]: work the contact reactions f [N/m] do on rock nodes moving at v [m/s] over w [s]."""
+    i = wp.tid()
+    f = f_react[i]
+    if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
+        wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(f, v[i]))

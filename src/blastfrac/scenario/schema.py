@@ -476,16 +476,20 @@ class CouplingConfig(_Strict):
         "the chatter spikes on the wall but lets particles leak through it (piston and leak tests fail).",
     )
     damping_ratio: float = Field(
-        0.0, ge=0, le=1, description="Normal contact dashpot as a fraction of critical [-]. Off by default: its "
-        "force reaches a particle through the grid, so the energy it removes is only estimated (energy.csv).",
+        0.0, ge=0, le=1, description="Normal contact dashpot as a fraction of critical [-]; off by default. The "
+        "energy it removes is part of contact_energy (energy.csv). 0.7 damps the contacts' ringing on a borehole "
+        "wall (tests/verification/test_coupling_wall_load.py).",
     )
     friction: float = Field(0.0, ge=0, le=2, description="Gas–rock friction coefficient [-]; 0 for an inviscid gas.")
     rebuild_interval: int = Field(
         5, ge=1, le=100, description="Steps between rebuilds of the exposed-edge search structure [-]."
     )
     wall_clearance: float = Field(
-        1.0, ge=0, le=3, description="Seeded particles closer than this many particle radii to a rock edge are "
-        "removed (the charge's area is kept by scaling the others) [-].",
+        1.0, ge=0, le=3, description="Seeded particles must lie at least this many nominal particle radii "
+        "(h/(2·points_per_cell)) from a rock edge [-]. Those short of it by less than half of it are moved straight "
+        "away from the edge (the outer ring of a conformal seeding then touches the meshed wall, whose chords cut "
+        "inside the circle); the others, and any inside the rock, are removed and the charge's area is kept by "
+        "scaling the rest. 1 = a particle touches the wall.",
     )
 
 
