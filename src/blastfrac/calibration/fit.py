@@ -26,6 +26,10 @@ Staged; each stage is a small, documented scipy problem (METHOD §5.4):
    depend on the mesh, so the search result is a starting point, not the answer there).
 6. **Sensitivities** d ln(macro)/d ln(micro) by one-sided differences (+5 %; φ: +2°) on the search
    meshes: kn, ks, T, c, φ against E, ν (static solves) and σt, UCS (runs).
+7. **Identifiability** of every fitted micro-parameter from those sensitivities
+   (:mod:`.identifiability`): ``not identifiable`` when no targeted macro responds to it
+   (max |d ln macro/d ln micro| < ``identifiability_threshold``), with the range of values that
+   reproduce the targets within tolerance (alone and with the others re-adjusted).
 
 Every quasi-static run counts against ``budget``; static solves do not (they are counted apart).
 When the budget runs out the best point so far is returned.
@@ -46,6 +50,7 @@ from ..scenario.schema import RockConfig
 from .brazilian import run_brazilian
 from .curves import plane_strain_to_3d
 from .elastic import edge_density, effective_moduli, static_moduli
+from .identifiability import identifiability_of_report
 from .quasistatic import LoadSettings
 from .specimens import ucs_specimen
 from .ucs import run_ucs
@@ -76,6 +81,9 @@ class FitConfig:
     strength_rounds: int = 2
     sensitivity: bool = True
     sensitivity_step: float = 0.05
+    identifiability_threshold: float = 0.1   # |d ln macro/d ln micro| below this: not identifiable
+    identifiability_cap: float = 10.0        # identifiability intervals are capped at ×/÷ this factor
+    identifiability_probe: int = 2           # runs per side measuring the range of a non-identifiable one (0: off)
 
 
 def load_targets(path: str | Path) -> FitConfig:
@@ -108,6 +116,8 @@ def load_targets(path: str | Path) -> FitConfig:
     ep = cfg.elastic_parameters
     if len(ep) != 2 or len(set(ep)) != 2 or not set(ep) <= set(ELASTIC_KEYS):
         raise ScenarioError(f"{p}: fit.elastic_parameters must be two of {list(ELASTIC_KEYS)}, got {list(ep)}")
+    if not cfg.identifiability_threshold > 0 or not cfg.identifiability_cap > 1:
+        raise ScenarioError(f"{p}: fit.identifiability_threshold must be > 0 and fit.identifiability_cap > 1")
     for name in ("stiffness_bounds", "penalty_range"):
         b = getattr(cfg, name)
         if b is not None and (len(b) != 2 or not 0 < b[0] < b[1]):
@@ -416,11 +426,53 @@ def fit(rock: RockConfig, cfg: FitConfig, lab: Lab, search: Lab | None = None, r
             report["sensitivity"] = sensitivity(lb, rock, cfg.sensitivity_step)
         except BudgetExhausted as e:
             report["sensitivity"] = {"skipped": str(e)}
+    report["identifiability"] = ident = identifiability_of_report(report, cfg.identifiability_threshold,
+                                                                  cfg.identifiability_cap)
+    if cfg.identifiability_probe > 0 and "parameters" in ident:
+        probe_flat(search or lab, rock, ident, report["sensitivity"], cfg.identifiability_probe)
     report["simulations"] = lab.used
     report["static_solves"] = lab.static_solves + (search.static_solves if search else 0)
     report["history"] = (search.history if search else []) + lab.history
     report["wall_s"] = time.perf_counter() - t0
     return report
+
+
+def measure(lab: Lab, rock: RockConfig, keys) -> dict:
+    """The macro properties ``keys`` of ``rock`` on ``lab``'s meshes: E, ν by a static solve (free),
+    σt by a Brazilian run, UCS by a UCS run."""
+    out: dict = {}
+    if {"youngs_modulus", "poisson_ratio"} & set(keys):
+        out["youngs_modulus"], out["poisson_ratio"], _ = lab.elastic(rock)
+    if "tensile_strength" in keys:
+        out["tensile_strength"] = lab.brazilian(rock)
+    if "ucs" in keys:
+        out["ucs"] = lab.ucs(rock)[0]
+    return out
+
+
+STRENGTH_ONLY = ("tensile_strength", "cohesion", "friction_angle")
+
+
+def probe_flat(lab: Lab, rock: RockConfig, ident: dict, sens: dict, tries: int) -> None:
+    """Measure the range of every 'not identifiable' parameter (:func:`.identifiability.probe_interval`)
+    on ``lab``'s meshes around ``rock``: all targeted macros are measured at each probe point (strength
+    parameters cannot change E, ν, which are skipped for them). Updates ``ident`` in place."""
+    from .identifiability import SYMBOL, probe_interval, probed_statement
+
+    tol = ident["tolerances"]
+    for name, entry in ident["parameters"].items():
+        if entry["status"] != "not identifiable":
+            continue
+        keys = [k for k in tol if not (name in STRENGTH_ONLY and k in ("youngs_modulus", "poisson_ratio"))]
+        ptol = {k: tol[k] for k in keys}
+        try:
+            res = probe_interval(lambda x: measure(lab, _with(rock, **{name: x}), keys), entry["value"],
+                                 sens["base"], ptol, entry["interval_alone"], tries, lab.log, SYMBOL.get(name, name))
+        except BudgetExhausted as e:
+            entry["probe"] = {"skipped": str(e)}
+            continue
+        entry.update(res)
+        entry["statement"] = probed_statement(entry, SYMBOL.get(name, name), ptol, lab.name)
 
 
 def sensitivity(lab: Lab, rock: RockConfig, step: float) -> dict:

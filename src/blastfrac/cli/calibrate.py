@@ -190,5 +190,13 @@ def _fit(args, rock, us, bs, hu, hb, seed, dev, out: Path):
     if "base" in sens:
         print(f"sensitivities d ln(macro)/d ln(micro) on the {sens['mesh']} meshes:")
         print(sensitivity_table(sens))
-    keys = ("targets", "fitted", "achieved", "achieved_on", "relative_error", "simulations", "static_solves", "wall_s")
-    return fitted, {k: rep[k] for k in keys}
+    ident = rep.get("identifiability", {})
+    if "parameters" in ident:
+        print(f"identifiability (first order, {ident['mesh']} meshes; threshold {ident['threshold']:g}):")
+        for p in ident["parameters"].values():
+            print("  " + p["statement"])
+    elif ident:
+        print(f"identifiability: {ident.get('skipped')}")
+    keys = ("targets", "fitted", "achieved", "achieved_on", "relative_error", "simulations", "static_solves",
+            "identifiability", "wall_s")
+    return fitted, {k: rep[k] for k in keys if k in rep}
