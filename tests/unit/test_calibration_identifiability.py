@@ -80,6 +80,23 @@ def test_probe_confirms_flat_side_and_brackets_the_kink():
     assert res["measured_interval"] == pytest.approx([12.0, 120.0])
 
 
+def test_probe_that_leaves_tolerance_on_both_sides_makes_the_parameter_identifiable():
+    """A response that the +5 % difference misses (flat within ±6 %, then ∝ x^0.5) is bounded by the probe."""
+    from blastfrac.calibration.identifiability import measured_status, probe_interval
+
+    def measure(x):
+        return {"ucs": 100.0 if abs(math.log(x)) < 0.06 else 100.0 * x**0.5}
+
+    entry = identifiability({"ks": {"ucs": 0.0}}, {"ucs": 0.02}, {"ks": 1.0})["ks"]
+    assert entry["status"] == "not identifiable"
+    entry.update(probe_interval(measure, 1.0, {"ucs": 100.0}, {"ucs": 0.02}, entry["interval_alone"], tries=2,
+                                log=lambda *_: None))
+    # ×/÷10 and ×/÷√10 are all out of tolerance: nothing confirmed, bracketed by ÷√10 and ×√10
+    assert entry["measured_interval"] == [1.0, 1.0]
+    assert entry["measured_bracket"] == pytest.approx([10**-0.5, 10**0.5])
+    assert measured_status(entry) == "identifiable (measured)"
+
+
 def test_relative_tolerances_follow_the_fit():
     tol = relative_tolerances({"youngs_modulus": 50e9, "poisson_ratio": 0.2, "ucs": 1e8}, 0.01, 0.005, 0.02)
     assert tol == pytest.approx({"youngs_modulus": 0.01, "poisson_ratio": 0.025, "ucs": 0.02})
@@ -124,8 +141,11 @@ ROCK = RockConfig(stiffness_mode="per_area", kn=1.8e15, ks=1.6e15, tensile_stren
 
 
 def _fit(targets):
+    import json
+
     rep = fit(ROCK, FitConfig(targets=targets), ModelLab())
     assert all(abs(e) <= 0.02 for e in rep["relative_error"].values()), rep["relative_error"]
+    json.dumps(rep["identifiability"])          # plain JSON types (calibration.json is written without a default)
     return rep["identifiability"]["parameters"]
 
 

@@ -457,7 +457,7 @@ def probe_flat(lab: Lab, rock: RockConfig, ident: dict, sens: dict, tries: int) 
     """Measure the range of every 'not identifiable' parameter (:func:`.identifiability.probe_interval`)
     on ``lab``'s meshes around ``rock``: all targeted macros are measured at each probe point (strength
     parameters cannot change E, ν, which are skipped for them). Updates ``ident`` in place."""
-    from .identifiability import SYMBOL, probe_interval, probed_statement
+    from .identifiability import SYMBOL, measured_status, probe_interval, probed_statement
 
     tol = ident["tolerances"]
     for name, entry in ident["parameters"].items():
@@ -472,6 +472,7 @@ def probe_flat(lab: Lab, rock: RockConfig, ident: dict, sens: dict, tries: int) 
             entry["probe"] = {"skipped": str(e)}
             continue
         entry.update(res)
+        entry["status"] = measured_status(entry)
         entry["statement"] = probed_statement(entry, SYMBOL.get(name, name), ptol, lab.name)
 
 

@@ -17,8 +17,10 @@ relative tolerance tol_k of each targeted macro (the fit's own tolerances):
 
 The sensitivities are one-sided differences (+5 %), so the range is a local, first-order statement:
 a response with a kink (σt flat in T above the point where Mohr–Coulomb takes over, linear below)
-can make the range on the far side of the kink too wide. ``fit.json`` says so, and the fit's own
-1-D scans (``strength_stages``) show the measured points.
+can make the range on the far side of the kink too wide, and a noisy response (the UCS of a brittle
+lattice jumps with small changes of kn, ks) can hide a real dependence. The fit therefore *measures*
+the range of every parameter it finds not identifiable (:func:`probe_interval`); if targets leave
+their tolerance on both sides, the status becomes ``identifiable (measured)``.
 """
 
 from __future__ import annotations
@@ -63,7 +65,7 @@ def _joint_half_widths(S, tol, cap_ln):
             cvec[j] = -sign                      # maximise sign·δ_j
             res = linprog(cvec, A_ub=A, b_ub=b, bounds=[(-cap_ln, cap_ln)] * n, method="highs")
             if res.status == 0:
-                best = max(best, sign * res.x[j])
+                best = max(best, float(sign * res.x[j]))
         out.append(best)
     return out
 
@@ -92,8 +94,8 @@ def identifiability(sens: dict, tol: dict, values: dict, free: list[str] | None 
         w_alone = min(w, cap_ln)
         w_joint = min(joint[col], cap_ln)
         x = float(values[j])
-        open_alone = w >= cap_ln * (1 - 1e-9)
-        open_joint = w_joint >= cap_ln * (1 - 1e-6)
+        open_alone = bool(w >= cap_ln * (1 - 1e-9))
+        open_joint = bool(w_joint >= cap_ln * (1 - 1e-6))
         if smax < threshold:
             status = "not identifiable"
         elif open_joint:
@@ -134,25 +136,45 @@ def probe_interval(measure, x_fit: float, base: dict, tol: dict, ends: tuple, tr
         x = float(end)
         for _ in range(tries):
             vals = measure(x)
-            dev = {k: vals[k] / base[k] - 1.0 for k in tol if k in vals}
-            ok = all(abs(d) <= tol[k] for k, d in dev.items())
-            points.append({"value": x, "macro": vals, "relative_change": dev, "within_tolerance": ok})
+            dev = {k: float(vals[k] / base[k] - 1.0) for k in tol if k in vals}
+            ok = bool(all(abs(d) <= tol[k] for k, d in dev.items()))
+            points.append({"value": x, "macro": {k: float(v) for k, v in vals.items()}, "relative_change": dev,
+                           "within_tolerance": ok})
             log(f"  identifiability probe {name} = {x:.4g}: " + ", ".join(
                 f"{MACRO_SYMBOL.get(k, k)} {d:+.2%}" for k, d in dev.items()) + (" (within)" if ok else " (out)"))
             if ok:
                 confirmed[side] = x
                 break
             x = math.sqrt(x * x_fit)
-    return {"measured_interval": confirmed, "probe_points": sorted(points, key=lambda p: p["value"])}
+    below = [p["value"] for p in points if not p["within_tolerance"] and p["value"] < x_fit]
+    above = [p["value"] for p in points if not p["within_tolerance"] and p["value"] > x_fit]
+    bracket = [max(below) if below else None, min(above) if above else None]
+    return {"measured_interval": confirmed, "measured_bracket": bracket,
+            "probe_points": sorted(points, key=lambda p: p["value"])}
+
+
+def measured_status(entry: dict) -> str:
+    """Status after a probe: ``identifiable (measured)`` when probe points on *both* sides moved a
+    target out of tolerance (the parameter is bounded, the one-sided sensitivity missed it: a noisy or
+    non-smooth response); otherwise ``not identifiable`` (on at least one side the range reaches the
+    first-order end, ×/÷ cap for a flat response)."""
+    lo, hi = entry["measured_bracket"]
+    return "identifiable (measured)" if lo is not None and hi is not None else "not identifiable"
 
 
 def probed_statement(entry: dict, name: str, tol: dict, mesh: str) -> str:
     a, b = entry["measured_interval"]
     out = [p for p in entry["probe_points"] if not p["within_tolerance"]]
     tols = ", ".join(f"{MACRO_SYMBOL.get(k, k)} ±{v:.1%}" for k, v in tol.items())
-    text = (f"{name} = {entry['value']:.4g}: not identifiable (max |d ln macro/d ln {name}| = "
-            f"{entry['max_response']:.3f} < threshold): measured on the {mesh} meshes, any value in [{a:.4g}, {b:.4g}] "
-            f"reproduces the fitted point's macro values within tolerance ({tols})")
+    if entry["status"] == "identifiable (measured)":
+        lo, hi = entry["measured_bracket"]
+        text = (f"{name} = {entry['value']:.4g}: identifiable (measured): the one-sided sensitivity "
+                f"{entry['max_response']:.3f} is below the threshold, but runs on the {mesh} meshes bracket it: "
+                f"within tolerance ({tols}) on [{a:.4g}, {b:.4g}], out of tolerance at {lo:.4g} and {hi:.4g}")
+    else:
+        text = (f"{name} = {entry['value']:.4g}: not identifiable (max |d ln macro/d ln {name}| = "
+                f"{entry['max_response']:.3f} < threshold): measured on the {mesh} meshes, any value in "
+                f"[{a:.4g}, {b:.4g}] reproduces the fitted point's macro values within tolerance ({tols})")
     if out:
         text += "; out of tolerance at " + ", ".join(
             f"{p['value']:.4g} (" + ", ".join(f"{MACRO_SYMBOL.get(k, k)} {d:+.1%}" for k, d in
