@@ -11,6 +11,7 @@ contact force over neighbouring particles, so single speeds may exceed it a litt
 """
 
 import numpy as np
+import pytest
 
 from blastfrac.coupling.particle_edge import NEW_CONTACT_SLACK_NP, edge_overlap_np
 from blastfrac.scenario import scenario_from_dict
@@ -81,3 +82,44 @@ def test_deep_first_contact_does_not_fire_particles():
     assert v_full > 5 * v_allow                              # the test can tell the two laws apart
     assert vmax < 1.5 * v_allow
     assert ke < 1.2 * ke_allow
+
+
+def test_switch_of_deepest_feature_keeps_the_force_continuous():
+    """A particle deep inside a rock corner whose deepest edge changes must not be fired.
+
+    One triangle, corner at (L, 0) between the bottom edge (outward normal −y) and the right edge (+x). The
+    particle first meets the right edge 0.6 r_p deep (δ₀ = 0.5 r_p ignored, 0.1 r_p pushes), then sits
+    where the bottom edge is the deeper one (1.9 r_p). Reusing the right edge's δ₀ against the bottom edge
+    would push with k_c·1.4 r_p, fourteen times the slack (what made a single-hole blast go unstable);
+    the ignored part is re-based on the switch, so the force stays at k_c·0.1 r_p.
+    """
+    from blastfrac.coupling import GasRockCoupler
+    from blastfrac.materials.jwl import JWLParams
+    from blastfrac.model.builder import ModelBuilder
+    from blastfrac.mpm.grid import GridSpec
+    from blastfrac.mpm.solver import MPMOptions, MPMSolver
+    from conftest import scenario
+    from coupling_helpers import structured_rectangle
+
+    L, rp, kc = 0.01, 1e-3, 1e9
+    model = ModelBuilder(scenario(geometry={"domain": {"type": "rectangle", "width": 1.0, "height": 1.0},
+                                            "mesh_size": 0.01}),
+                         mesh=structured_rectangle(0.0, 0.0, L, L, 1, 1)).finalize("cpu")
+    st = model.state()
+    gas = JWLParams(rho0=1000.0, D=1000.0, A=0.0, B=0.0, R1=4.0, R2=1.0, omega=0.4, E0=1e3)
+    spec = GridSpec.from_bounds((-0.01, -0.01), (0.02, 0.02), 2.5e-3)
+    x1 = np.array([[L + 0.4 * rp, 0.5 * rp]])             # right of the corner: 0.6 r_p into the right edge
+    mpm = MPMSolver.from_arrays(x1, np.array([4 * rp * rp]), spec, gas, MPMOptions(), burn=np.zeros(1))
+    cp = GasRockCoupler(model, mpm, kc=kc, rebuild_interval=1)
+    cp.apply(st, 1e-9)
+    f1 = np.linalg.norm(mpm.f_ext_p.numpy()[0])
+    mpm.x.assign(np.array([[L - 0.3 * rp, 0.9 * rp]]))   # inside the corner: bottom edge 1.9 r_p deep, right 1.3
+    st.f.zero_()
+    cp.apply(st, 1e-9)
+    f2 = mpm.f_ext_p.numpy()[0]
+    slack = NEW_CONTACT_SLACK_NP * rp
+    print(f"\n  first contact {f1 / (kc * slack):.2f}, after the switch {np.linalg.norm(f2) / (kc * slack):.2f} k_c·slack; "
+          f"direction {f2 / np.linalg.norm(f2)}")
+    assert f1 == pytest.approx(kc * slack, rel=1e-6)
+    assert f2[1] < 0 and abs(f2[0]) < 1e-9 * abs(f2[1]), "the bottom edge pushes now"
+    assert np.linalg.norm(f2) < 1.01 * kc * slack

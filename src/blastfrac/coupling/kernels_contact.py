@@ -74,6 +74,7 @@ def eval_particle_edge_contact(
     preload: wp.float64,
     hist_e_in: wp.array(dtype=wp.int32),
     hist_d_in: wp.array(dtype=wp.float64),
+    hist_x_in: wp.array(dtype=wp.float64),
     f_p: wp.array(dtype=wp.vec2d),
     fm_p: wp.array(dtype=wp.mat22d),
     f_rock: wp.array(dtype=wp.vec2d),
@@ -81,11 +82,13 @@ def eval_particle_edge_contact(
     acc: wp.array(dtype=wp.float64),
     hist_e_out: wp.array(dtype=wp.int32),
     hist_d_out: wp.array(dtype=wp.float64),
+    hist_x_out: wp.array(dtype=wp.float64),
 ):
     """Contact force on each particle (assigned to f_p) and its reactions (added to f_rock), METHOD §3.
 
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
-    each (element, ignored initial overlap δ₀ [m]); element −1 marks an empty slot.
+    each (8·element + feature, ignored initial overlap δ₀ [m], effective overlap δ − δ₀ [m]); feature 0–2:
+    edge k, 3–5: vertex k; −1 marks an empty slot.
     """
     p = wp.tid()
     zero = wp.float64(0.0)
@@ -114,6 +117,7 @@ def eval_particle_edge_contact(
         bn = wp.vec2d(zero, zero)
         ia = int(-1)
         ib = int(-1)
+        bk = int(-1)
         bxi = wp.float64(0.0)
         for k in range(3):
             s = 3 * e + k
@@ -125,6 +129,7 @@ def eval_particle_edge_contact(
                     bn = ne
                     ia = s
                     ib = b
+                    bk = k
                     bxi = xie
         for k in range(3):
             a = 3 * e + k
@@ -135,6 +140,7 @@ def eval_particle_edge_contact(
                     bn = nv
                     ia = a
                     ib = a
+                    bk = 3 + k
                     bxi = zero
         if best > zero:
             wa = one - bxi
@@ -143,16 +149,26 @@ def eval_particle_edge_contact(
             cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
             arm = -surface * rp * bn                       # contact point (disk surface) − particle centre [m]
             vrel = vp + grad_v[p] * arm - vc               # gas velocity at the contact point − wall velocity
-            # initial overlap δ₀: kept from the last step's contact with e, else what a new contact cannot explain
+            # initial overlap δ₀ (ignored part of the overlap): kept from the last step's contact with element e, else
+            # what a new contact cannot explain. The deepest feature of an element (edge or vertex bk) can change,
+            # e.g. for a particle an element rotated over; δ₀ belonged to the old feature, so it is re-based to keep
+            # the force continuous, δ₀ = δ − (δ − δ₀)_last. (Reusing it against the new feature made the force jump
+            # by k_c times the difference, 140 µm once in a single-hole blast, and the run went unstable; treating
+            # the switch as a new contact gave the slack k_c·0.1r_p for free at every switch.)
+            key = 8 * e + bk
             d0 = wp.float64(-1.0)
             for h in range(CONTACT_HISTORY):
-                if hist_e_in[h0 + h] == e:
+                he = hist_e_in[h0 + h]
+                if he == key:
                     d0 = wp.min(hist_d_in[h0 + h], best)
+                elif he >= 0 and he // 8 == e:
+                    d0 = wp.max(best - hist_x_in[h0 + h], zero)
             if d0 < zero:
                 d0 = initial_overlap(best, wp.dot(vrel, bn), dt, rp)
             if ncon < CONTACT_HISTORY:
-                hist_e_out[h0 + ncon] = e
+                hist_e_out[h0 + ncon] = key
                 hist_d_out[h0 + ncon] = d0
+                hist_x_out[h0 + ncon] = best - d0
             best = best - d0
             fcap = wp.float64(0.0)
             if kappa > zero:
