@@ -90,7 +90,8 @@ class Simulation:
         cj = cj_report(self.gas.material, ex.name or "custom")
         kc = cp.contact_stiffness or default_contact_stiffness(self.gas.p_cj, cp.stiffness_factor)
         self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval,
-                                      force_cap=cp.force_cap)
+                                      force_cap=cp.force_cap, surface_forces=cp.surface_forces,
+                                      pressure_preload=cp.pressure_preload)
         self.gas_report = {
             "particles": self.gas.n, "removed_at_seeding": removed[0], "grid_nodes": self.gas.spec.node_count,
             "cell_size": self.gas.spec.h, "contact_stiffness": kc, "contact_dt": self.coupler.stable_dt(),
