@@ -170,7 +170,7 @@ def probed_statement(entry: dict, name: str, tol: dict, mesh: str) -> str:
         lo, hi = entry["measured_bracket"]
         text = (f"{name} = {entry['value']:.4g}: identifiable (measured): the one-sided sensitivity "
                 f"{entry['max_response']:.3f} is below the threshold, but runs on the {mesh} meshes bracket it: "
-                f"within tolerance ({tols}) on [{a:.4g}, {b:.4g}], out of tolerance at {lo:.4g} and {hi:.4g}")
+                f"within tolerance ({tols}) on [{a:.4g}, {b:.4g}]")
     else:
         text = (f"{name} = {entry['value']:.4g}: not identifiable (max |d ln macro/d ln {name}| = "
                 f"{entry['max_response']:.3f} < threshold): measured on the {mesh} meshes, any value in "
