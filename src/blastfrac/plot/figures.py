@@ -142,7 +142,7 @@ def gas_particles(path: Path, xp: np.ndarray, p: np.ndarray, x: np.ndarray, seg:
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(title or "Gas pressure", fontsize=9)
+    fig.suptitle(title or "Gas pressure", fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
