@@ -116,8 +116,12 @@ class GasRockCoupler:
         m = self.model
         self.count.zero_()
         self.reach_max.zero_()
+        sp = self.mpm.spec
+        lo = wp.vec2d(sp.x0, sp.y0)
+        hi = wp.vec2d(sp.x0 + (sp.nx - 1) * sp.h, sp.y0 + (sp.ny - 1) * sp.h)
+        margin = wp.float64((1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max)
         wp.launch(collect_exposed_elements, dim=m.element_count,
-                  inputs=[self.slot_iface, state.pair_mode, state.x, self.elem_reach],
+                  inputs=[self.slot_iface, state.pair_mode, state.x, self.elem_reach, lo, hi, margin],
                   outputs=[self.count, self.elems, self.points, self.reach_max], device=m.device)
         self.n_exposed = int(self.count.numpy()[0])
         reach = float(self.reach_max.numpy()[0])

@@ -28,19 +28,30 @@ def collect_exposed_elements(
     pair_mode: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
     elem_reach: wp.array(dtype=wp.float64),
+    box_lo: wp.vec2d,
+    box_hi: wp.vec2d,
+    margin: wp.float64,
     count: wp.array(dtype=wp.int32),
     elems: wp.array(dtype=wp.int32),
     points: wp.array(dtype=wp.vec3d),
     reach_max: wp.array(dtype=wp.float64),
 ):
-    """Compact list of elements with an exposed edge, their centroids (z = 0) and the largest reach [m]."""
+    """Compact list of elements with an exposed edge, their centroids (z = 0) and the largest reach [m].
+
+    Only elements that a particle inside the box box_lo..box_hi [m] (the MPM grid, which particles never
+    leave) can reach are listed: centroid within reach + margin [m] of the box. Large far-field boundary
+    elements would otherwise set the search radius of every particle.
+    """
     e = wp.tid()
     s = 3 * e
     if not (slot_exposed(s, slot_iface, pair_mode) or slot_exposed(s + 1, slot_iface, pair_mode)
             or slot_exposed(s + 2, slot_iface, pair_mode)):
         return
-    k = wp.atomic_add(count, 0, 1)
     c = (x[s] + x[s + 1] + x[s + 2]) / wp.float64(3.0)
+    r = elem_reach[e] + margin
+    if c[0] < box_lo[0] - r or c[0] > box_hi[0] + r or c[1] < box_lo[1] - r or c[1] > box_hi[1] + r:
+        return
+    k = wp.atomic_add(count, 0, 1)
     elems[k] = e
     points[k] = wp.vec3d(c[0], c[1], wp.float64(0.0))
     wp.atomic_max(reach_max, 0, elem_reach[e])
