@@ -147,7 +147,7 @@ class GasRockCoupler:
             self._hist[0][0].fill_(-1)
             return
         wp.launch(eval_particle_edge_contact, dim=mpm.n,
-                  inputs=[self.grid.id, self.elems, self.slot_iface, state.pair_mode, state.x, state.v, m.node_mass,
+                  inputs=[self.grid.id, self.elems, self.points, self.elem_reach, self.slot_iface, state.pair_mode, state.x, state.v, m.node_mass,
                           mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p, mpm.rho, mpm.active,
                           wp.float64(self.kc), wp.float64(self.force_cap), wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
                           wp.float64(self.query_radius), wp.float64(dt),

@@ -61,6 +61,8 @@ def collect_exposed_elements(
 def eval_particle_edge_contact(
     grid: wp.uint64,
     elems: wp.array(dtype=wp.int32),
+    points: wp.array(dtype=wp.vec3d),
+    elem_reach: wp.array(dtype=wp.float64),
     slot_iface: wp.array(dtype=wp.int32),
     pair_mode: wp.array(dtype=wp.int32),
     x_rock: wp.array(dtype=wp.vec2d),
@@ -97,6 +99,7 @@ def eval_particle_edge_contact(
 ):
     """Contact force on each particle (assigned to f_p) and its reactions (added to f_rock), METHOD §3.
 
+    points, elem_reach: the listed elements' centroids at the last rebuild [m] and their reach [m] (per element).
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
     each (8·element + feature, ignored initial overlap δ₀ [m], effective overlap δ − δ₀ [m]); feature 0–2:
     edge k, 3–5: vertex k; −1 marks an empty slot.
@@ -124,6 +127,14 @@ def eval_particle_edge_contact(
     idx = int(0)
     while wp.hash_grid_query_next(query, idx):
         e = elems[idx]
+        # the hash returns whole cells: skip elements whose reach (from the centroid listed at the last rebuild,
+        # with the same allowance for motion as the search radius) cannot meet the particle's contact disk
+        c = points[idx]
+        dx = xp[0] - c[0]
+        dy = xp[1] - c[1]
+        lim = elem_reach[e] + rc
+        if dx * dx + dy * dy > lim * lim:
+            continue
         best = wp.float64(-1.0)
         bn = wp.vec2d(zero, zero)
         ia = int(-1)
