@@ -33,6 +33,7 @@ EXAMPLES := examples/circular_rock/scenario.toml examples/single_hole/scenario.t
 validate: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q -m slow
 	for s in $(EXAMPLES); do $(BIN)/blastfrac run $$s || exit 1; done
+	$(BIN)/python examples/confined_blast/compare.py --out out/confined_blast_compare
 
 ## bench: performance suite (throughput and scaling), results printed and appended to benchmarks/
 bench: $(VENV)/.installed
