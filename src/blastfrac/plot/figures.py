@@ -42,7 +42,7 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.set_title(title or "Fracture pattern", fontsize=10)
+    ax.set_title(title or "Fracture pattern", fontsize=9, wrap=True)
     if len(seg):
         ax.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
