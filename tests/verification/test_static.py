@@ -8,26 +8,24 @@ import pytest
 from blastfrac.cdem.solver import CDEMSolver
 from blastfrac.model.builder import ModelBuilder
 from blastfrac.simulation import Simulation
-from conftest import ROCK, effective_plane_strain_moduli, interior_edge_density, scenario
+from conftest import ROCK, scenario
 from verification.static_helpers import element_polar, relax
 
 K_SPRING = 5.0e15  # Pa/m
 
 
 def test_lame_thick_walled_cylinder():
+    """Dynamic relaxation of the default (penalty, compensated) assembly to Lamé with the *input* E, ν:
+    no spring-compliance correction here (the builder compensates the blocks, model/compliance.py)."""
     a, b, p = 0.005, 0.05, 100e6
-    sc = scenario(rock={"stiffness_mode": "per_area", "kn": K_SPRING, "ks": K_SPRING},
+    sc = scenario(rock={"stiffness_mode": "penalty", "spring_penalty": 20.0},
                   geometry={"domain": {"type": "disc", "radius": b}, "boreholes": [{"radius": a}],
-                            "mesh_size": 0.0025, "mesh_size_near": 0.0006, "refinement_distance": 0.02},
+                            "mesh_size": 0.0025, "mesh_size_near": 0.0005, "refinement_distance": 0.02},
                   borehole_pressure=[{"borehole": 0, "pulse": {"type": "constant", "value": p}}])
     m = ModelBuilder(sc).finalize("cpu")
     st, solver = m.state(), CDEMSolver(m, block_contact=False)
     steps = relax(m, st, solver)
-    # effective plane-strain moduli → (E, ν) of the equivalent continuum
-    Ep, nup = effective_plane_strain_moduli(ROCK["youngs_modulus"], ROCK["poisson_ratio"],
-                                            interior_edge_density(m), K_SPRING, K_SPRING)
-    nu = nup / (1 + nup)
-    E = Ep * (1 - nu**2)
+    E, nu = ROCK["youngs_modulus"], ROCK["poisson_ratio"]
 
     def u_lame(r):
         return (1 + nu) * p * a**2 / (E * (b**2 - a**2)) * ((1 - 2 * nu) * r + b**2 / r)
@@ -41,9 +39,9 @@ def test_lame_thick_walled_cylinder():
     wall = rX < a * 1.0001
     u_wall = u_r[wall].mean()
     print(f"Lamé ({steps} steps): u(a) = {u_wall * 1e6:.4f} µm, expected {u_lame(a) * 1e6:.4f} µm")
-    assert u_wall == pytest.approx(u_lame(a), rel=0.02)
+    assert u_wall == pytest.approx(u_lame(a), rel=0.01)
     mid = np.abs(rX - 0.02) < 0.002
-    assert np.mean(u_r[mid]) == pytest.approx(np.mean(u_lame(rX[mid])), rel=0.02)
+    assert np.mean(u_r[mid]) == pytest.approx(np.mean(u_lame(rX[mid])), rel=0.01)
     r, _, _, stt = element_polar(m, st)
     # ring averages (the solution is axisymmetric; single CST elements scatter around it)
     edges = np.arange(2 * a, 0.6 * b, 0.002)

@@ -38,6 +38,9 @@ def run(args) -> int:
 
     state_bytes = sum(v.capacity for v in vars(st).values() if isinstance(v, wp.array))
     dt = sc.simulation.dt_safety * m.stable_dt
+    el = m.elastic
+    cp, cs = el.assembly_speeds
+    cp0, _ = el.speeds(el.input_E, el.input_nu, el.density)
     steps = math.ceil(sc.simulation.end_time / dt)
     rows = [
         ("title", sc.title or "-"),
@@ -46,6 +49,11 @@ def run(args) -> int:
         ("nodes", f"{m.node_count}"),
         ("springs (node pairs)", f"{m.spring_count} on {m.interface_count} interfaces"),
         ("boreholes", f"{len(sc.geometry.boreholes)}"),
+        ("rock E, nu (input)", f"{el.input_E / 1e9:.4g} GPa, {el.input_nu:.4g}"),
+        ("block E, nu", f"{el.block_E / 1e9:.4g} GPa, {el.block_nu:.4g}"
+         + (" (compensated for the spring compliance)" if el.compensated else " (as given)")),
+        ("assembly E, nu, c_p, c_s", f"{el.assembly_E / 1e9:.4g} GPa, {el.assembly_nu:.4g}, {cp:.1f} m/s, {cs:.1f} m/s"
+         + f" (c_p {cp / cp0 - 1:+.2%} against the input)"),
         ("stable dt (Gershgorin)", f"{m.stable_dt:.4e} s"),
         ("dt used (x dt_safety)", f"{dt:.4e} s"),
         ("end time", f"{sc.simulation.end_time:.4e} s"),

@@ -10,6 +10,7 @@ import warp as wp
 from .._warp import init_warp
 from ..geometry.mesh import TriMesh, generate_mesh
 from ..materials.elastic import lame
+from .compliance import elastic_report, spring_compliance_density
 from ..materials.interface import softening_slope
 from ..scenario.schema import Scenario
 from .model import Model
@@ -32,7 +33,6 @@ class ModelBuilder:
         tri = mesh.triangles
         X = mesh.vertices[tri].reshape(-1, 2)
         area = 0.5 * _cross(X[1::3] - X[0::3], X[2::3] - X[0::3])
-        self.lam, self.mu = lame(rock.youngs_modulus, rock.poisson_ratio)
         h = {}
         h["node_X"] = X
         h["node_mass"] = np.repeat(rock.density * area / 3.0, 3)
@@ -50,6 +50,12 @@ class ModelBuilder:
             hbar = (area[e1] + area[e2]) / L          # mean of the two heights 2A/L
             kn_a = rock.spring_penalty * rock.plane_strain_modulus / hbar
             ks_a = kn_a.copy()
+        # block moduli: compensated for the springs' compliance so that the assembly has the input E, ν
+        # (penalty mode by default), or the input itself (model/compliance.py)
+        s_n, s_s = spring_compliance_density(L, kn_a, ks_a, float(area.sum()))
+        self.elastic = elastic_report(rock.youngs_modulus, rock.poisson_ratio, rock.density, s_n, s_s,
+                                      bool(rock.compensate_spring_compliance))
+        self.lam, self.mu = lame(self.elastic.block_E, self.elastic.block_nu)
         ac = L / 2.0
         h["pair_ac"] = np.repeat(ac, 2)
         h["pair_l0"] = np.repeat(L, 2)
@@ -87,8 +93,9 @@ class ModelBuilder:
             self.pulses.append(bp.pulse)
         sig0 = np.array([[sc.insitu.sxx, sc.insitu.sxy], [sc.insitu.sxy, sc.insitu.syy]])
         ln0, ln1, lp, lf = [], [], [], []
-        rho_cp = rock.density * rock.p_wave_speed
-        rho_cs = rock.density * rock.s_wave_speed
+        cp_eff, cs_eff = self.elastic.assembly_speeds      # the impedance of the assembly the waves travel in
+        rho_cp = rock.density * cp_eff
+        rho_cs = rock.density * cs_eff
         for slot, tag in zip(topo.boundary_slots, topo.boundary_slot_tags):
             n0 = int(slot)
             n1 = int(3 * (slot // 3) + (slot % 3 + 1) % 3)
@@ -189,6 +196,7 @@ class ModelBuilder:
             pulses=list(self.pulses),
             stable_dt=self.stable_dt,
             host=h,
+            elastic=self.elastic,
         )
         return m
 

@@ -74,6 +74,7 @@ class Model:
     q_lin: float = 0.0
     spring_damping: float = 0.0
     host: dict = field(default_factory=dict)
+    elastic: object = None    # model.compliance.ElasticReport: input, block and assembly moduli
 
     @property
     def c_p(self) -> float:
