@@ -1,13 +1,14 @@
 """Crack statistics (analysis/cracks.py) on crack patterns drawn into a real mesh, with known answers.
 
-Cracks are drawn by marking broken the interfaces that a straight ray from the hole centre crosses; the
-expected crack count, lengths and crushed-zone radius follow from how the pattern was drawn, not from the code.
+Cracks are drawn by marking broken the interfaces that a straight segment crosses (a ray from the hole wall for
+a radial crack); the expected crack count, lengths, crushed-zone radius and detached crack sets follow from how
+the pattern was drawn, not from the code.
 """
 
 import numpy as np
 import pytest
 
-from blastfrac.analysis.cracks import circle_crossings, crack_statistics, group_crossings
+from blastfrac.analysis.cracks import circle_crossings, crack_statistics, detached_interface_mask, group_crossings
 from blastfrac.model.builder import ModelBuilder
 from blastfrac.scenario import scenario_from_dict
 
@@ -33,10 +34,8 @@ def _interfaces(model):
     return X[pn[0::2, 0]], X[pn[1::2, 0]]
 
 
-def _ray_hits(a, b, theta, r0, r1):
-    """Interfaces a→b crossed by the ray segment from r0 to r1 at polar angle theta."""
-    u = np.array([np.cos(theta), np.sin(theta)])
-    p, q = r0 * u, r1 * u
+def _segment_hits(a, b, p, q):
+    """Interfaces a→b crossed by the segment p→q [m]."""
     d1, d2 = b - a, q - p
 
     def cross(x, y):
@@ -45,8 +44,14 @@ def _ray_hits(a, b, theta, r0, r1):
     den = cross(d1, d2)
     ok = np.abs(den) > 1e-18
     s = np.where(ok, cross(p - a, d2) / np.where(ok, den, 1), -1)       # along the interface
-    t = np.where(ok, cross(p - a, d1) / np.where(ok, den, 1), -1)       # along the ray
+    t = np.where(ok, cross(p - a, d1) / np.where(ok, den, 1), -1)       # along the segment
     return ok & (s >= 0) & (s <= 1) & (t >= 0) & (t <= 1)
+
+
+def _ray_hits(a, b, theta, r0, r1):
+    """Interfaces a→b crossed by the ray segment from r0 to r1 at polar angle theta."""
+    u = np.array([np.cos(theta), np.sin(theta)])
+    return _segment_hits(a, b, r0 * u, r1 * u)
 
 
 def _draw(model, crushed=0.0, shattered=None):
@@ -85,6 +90,8 @@ def test_separate_cracks_counted_with_lengths(model):
     print(f"drawn 8 cracks: count {s['radial_crack_count']}, r_c/r_b {s['crushed_zone_radius_over_rb']:.2f}, "
           f"lengths {np.round(s['radial_crack_lengths'], 4)} vs {np.round(ENDS[::-1] - R_B, 4)}")
     assert s["crushed_zone_radius"] == R_B            # 8 cracks cannot crack half of the first ring
+    assert s["detached_crack_sets"] == 0               # every ray starts at the wall
+    assert s["connected_interfaces"] == s["cracked_interfaces"] == int(mode[0::2].sum())
     assert s["radial_crack_count"] == 8
     assert s["radial_crack_count_tensile"] == 8
     expect = np.sort(ENDS - s["crushed_zone_radius"])[::-1]
@@ -115,3 +122,99 @@ def test_shattered_ring_is_not_counted_as_cracks(model):
     assert np.all(np.array(prof["count"])[inside] == 0)
     assert np.all(np.array(prof["shattered_arc"])[inside] > 0.9 * 2 * np.pi * R[inside])
     assert s["radial_crack_count"] == 8
+
+
+# A second pattern for the crack-network tests: K wall cracks out to R_WALL_TIP, and M cracks between them that
+# start away from the hole, at R_DET[0] … R_DET[1]: at every radius of that span all K + M cracks coexist.
+K, M = 4, 4
+WALL_ANGLES = 0.1 + 2 * np.pi * np.arange(K) / K
+DET_ANGLES = WALL_ANGLES + np.pi / K              # half way between two wall cracks (> 7 mesh sizes apart)
+R_WALL_TIP, R_DET = 0.09, (0.04, 0.08)
+
+
+def _rays(model, rays):
+    """Mask of the interfaces crossed by the rays (theta, r0, r1)."""
+    a, b = _interfaces(model)
+    hit = np.zeros(len(a), bool)
+    for th, r0, r1 in rays:
+        hit |= _ray_hits(a, b, th, r0, r1)
+    return hit
+
+
+def _mode(cracked):
+    return np.repeat(cracked.astype(np.int32), 2)     # both springs of a cracked interface, tensile
+
+
+def test_detached_cracks_are_reported_apart(model):
+    """Adding M cracks that do not reach the hole changes nothing in N(R) and the radial count; they are reported as
+    M detached sets with the drawn length. Over all cracked interfaces (the count before the crack network) the
+    same circles are crossed by K + M cracks."""
+    wall = _rays(model, [(th, R_B, R_WALL_TIP) for th in WALL_ANGLES])
+    detached = _rays(model, [(th, *R_DET) for th in DET_ANGLES])
+    assert not (wall & detached).any()                # the construction keeps the two families apart
+    s = crack_statistics(model, _mode(wall | detached), np.zeros(2), R_B)
+    s_wall = crack_statistics(model, _mode(wall), np.zeros(2), R_B)
+    a, b = _interfaces(model)
+    L = np.linalg.norm(b - a, axis=1)
+    prof = s["crossings"]
+    R, n, n_all = (np.asarray(prof[k]) for k in ("radius", "count", "count_all"))
+    mid = (R > R_DET[0] + 0.01) & (R < R_DET[1] - 0.01)
+    print(f"{K} wall + {M} detached cracks: count {s['radial_crack_count']} (wall cracks alone "
+          f"{s_wall['radial_crack_count']}, all cracked interfaces {n_all.max()}); median N(R) over "
+          f"{R[mid].min():.3f}-{R[mid].max():.3f} m: {np.median(n[mid]):g} (all: {np.median(n_all[mid]):g}); "
+          f"detached sets {s['detached_crack_sets']} ({s['detached_crack_sets_long']} long), "
+          f"length {s['detached_crack_length']:.4f} m vs drawn {L[detached].sum():.4f} m")
+    assert mid.any()
+    assert prof["count"] == s_wall["crossings"]["count"]            # the detached cracks are not counted anywhere
+    assert prof["count_tensile"] == s_wall["crossings"]["count_tensile"]
+    assert s["radial_crack_count"] == s_wall["radial_crack_count"]
+    assert s["radial_crack_lengths"] == s_wall["radial_crack_lengths"]
+    assert np.median(n[mid]) == K                     # where the detached cracks run, K cracks are counted ...
+    assert np.median(n_all[mid]) == K + M             # ... and counting every cracked interface would give K + M
+    assert n_all.max() >= K + M                       # the radial count before the crack network
+    assert s["detached_crack_sets"] == M
+    assert s["detached_crack_sets_long"] == M         # each spans 40 mm, about 10 elements
+    assert s["detached_crack_length"] == pytest.approx(L[detached].sum(), rel=1e-12)
+    assert s["connected_interfaces"] == int(wall.sum())
+    assert s["connected_crack_length"] == pytest.approx(L[wall].sum(), rel=1e-12)
+    # the per-interface mask for the figure is exactly the drawn detached set
+    assert np.array_equal(detached_interface_mask(model, _mode(wall | detached), [((0.0, 0.0), R_B)]), detached)
+
+
+def test_branch_of_a_wall_crack_is_connected(model):
+    """A crack branching off a wall crack at 50 mm (0.8 rad off its direction, 40 mm long, tip at 83 mm) belongs to
+    the network; beyond the branch point it crosses the circles as one more crack."""
+    wall = _rays(model, [(th, R_B, R_WALL_TIP) for th in WALL_ANGLES])
+    th0, s0, turn, length = WALL_ANGLES[0], 0.05, 0.8, 0.04
+    p = s0 * np.array([np.cos(th0), np.sin(th0)])
+    q = p + length * np.array([np.cos(th0 + turn), np.sin(th0 + turn)])
+    a, b = _interfaces(model)
+    branch = _segment_hits(a, b, p, q)
+    assert (branch & ~wall).sum() > 10
+    s = crack_statistics(model, _mode(wall | branch), np.zeros(2), R_B)
+    assert s["detached_crack_sets"] == 0
+    assert s["detached_crack_length"] == 0.0
+    assert s["connected_interfaces"] == int((wall | branch).sum())
+    R, n = np.asarray(s["crossings"]["radius"]), np.asarray(s["crossings"]["count"])
+    # from 64 mm the branch is more than 12 mm (3 elements) away from its parent crack; its tip is at 83 mm
+    span = (R > 0.064) & (R < 0.078)
+    assert span.any()
+    assert np.median(n[span]) == K + 1
+
+
+def test_crack_figures_show_detached_cracks(model, tmp_path):
+    """The crack-profile and fracture-pattern figures render with the detached sets (smoke test)."""
+    from blastfrac.io.paraview import crack_segments
+    from blastfrac.plot.figures import crack_profile, fracture_pattern
+
+    wall = _rays(model, [(th, R_B, R_WALL_TIP) for th in WALL_ANGLES])
+    detached = _rays(model, [(th, *R_DET) for th in DET_ANGLES])
+    mode = _mode(wall | detached)
+    s = crack_statistics(model, mode, np.zeros(2), R_B)
+    crack_profile(tmp_path / "profile.png", [s])
+    X = model.host["node_X"]
+    seg, cmode = crack_segments(model, mode, np.zeros(len(mode)))
+    seg_detached = detached_interface_mask(model, mode, [((0.0, 0.0), R_B)])[wall | detached]
+    assert seg_detached.sum() == detached.sum()
+    fracture_pattern(tmp_path / "pattern.png", X, seg, cmode, circles=[((0.0, 0.0), R_B)], detached=seg_detached)
+    assert (tmp_path / "profile.png").stat().st_size > 0 and (tmp_path / "pattern.png").stat().st_size > 0

@@ -1,24 +1,37 @@
-"""Crack statistics around a borehole: crushed-zone radius, radial crack count and lengths.
+"""Crack statistics around a borehole: crushed-zone radius, radial crack count and lengths, detached cracks.
 
 Definitions (documented in docs/results.md). Positions are those of the reference configuration; an
 interface is *cracked* when at least one of its two springs has broken, and r is the distance of a point
 from the hole centre.
 
+* **Crack network**: the graph whose nodes are the cracked interfaces, two of them being joined when they
+  share a mesh vertex (the vertex of the shared-vertex mesh, before the blocks were split). Its connected
+  components are the *crack sets*.
+* **Borehole wall**: the mesh-boundary vertices at distance ≤ r_b·(1 + ``WALL_TOL``) from the centre (the
+  vertices of the hole's polygon). Where there is none (a charge without a borehole, whose r_b is half the
+  charge's width), the boundary vertices within r_b + w.
 * **Ring width w**: the median length of the interfaces within 2 r_b of the centre (the mesh size at the wall).
 * **Crushed-zone radius r_c**: the outer radius of the run of consecutive rings [r_b + k·w, r_b + (k+1)·w),
   starting at the wall, in which at least half of the interfaces are cracked (r_c = r_b when the first ring
-  is below one half). It is the radius within which most springs have broken.
-* **Crack crossings of a circle** of radius R about the centre: the points where cracked interfaces cross
-  the circle, grouped by angle; two neighbouring crossings less than ``MERGE_GAP``·h apart along the circle
-  belong to the same crack (a crack zig-zags along element edges and can cross a circle several times), h
-  being the mesh size along that circle (median length of the interfaces it crosses). A group whose arc is
-  at most ``NARROW_ARC``·h long is one *crack crossing*; wider groups are shattered or tangential
-  (spalling) zones, not single cracks, and are reported apart (``shattered_arc``).
-* **N(R)**: the number of crack crossings of the circle R, sampled every w from r_c + 2w outward, for all
-  cracks and for tensile ones (an interface counts as tensile when a spring broke in tension). Crossings
-  of neighbouring circles are linked into radial chains, and only crossings on chains at least
-  ``MIN_EXTENT``·h long count (a crack is at least three elements long; this drops the ragged fringe of
-  crushed and spalled zones).
+  is below one half). It is the radius within which most springs have broken. Its value counts all cracked
+  interfaces, connected or not.
+* **Connected network** (of this hole): the crack sets that have a vertex on the wall, or, when r_c > r_b,
+  a vertex at r ≤ r_c (the crushed zone touches the wall by construction). All other crack sets are
+  **detached**: they are reported apart (number, total length, number of those of more than ``MIN_EXTENT``
+  interfaces) and count in no N(R). A crack set joined only to *another* borehole is detached for this one.
+* **Crack crossings of a circle** of radius R about the centre: the points where cracked interfaces of the
+  connected network cross the circle, grouped by angle; two neighbouring crossings less than ``MERGE_GAP``·h
+  apart along the circle belong to the same crack (a crack zig-zags along element edges and can cross a
+  circle several times), h being the mesh size along that circle (median length of the interfaces it
+  crosses). A group whose arc is at most ``NARROW_ARC``·h long is one *crack crossing*; wider groups are
+  shattered or tangential (spalling) zones, not single cracks. The shattered arc (``shattered_arc``) is
+  measured on all cracked interfaces, connected or not, since a detached fragmented zone is damage too.
+* **N(R)**: the number of crack crossings of the circle R, sampled every w from r_c + 2w outward, for the
+  connected network and for its tensile interfaces (an interface counts as tensile when a spring broke in
+  tension). Crossings of neighbouring circles are linked into radial chains, and only crossings on chains at
+  least ``MIN_EXTENT``·h long count (a crack is at least three elements long; this drops the ragged fringe
+  of crushed and spalled zones). ``count_all`` is the same count over all cracked interfaces, detached sets
+  included (for comparison only).
 * **Radial crack count** N_rad = max over R of N(R): every radial crack crosses each circle between its
   start and its tip, so the circle crossed by most cracks counts all the cracks that coexist at one radius.
   Unlike a count of connected crack sets, this does not collapse a network whose cracks meet in the
@@ -30,6 +43,8 @@ from the hole centre.
 from __future__ import annotations
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 #: crossings closer than this many ring widths along the circle belong to one crack [-]
 MERGE_GAP = 1.0
@@ -37,6 +52,8 @@ MERGE_GAP = 1.0
 NARROW_ARC = 3.0
 #: a chain of crossings shorter than this many local mesh sizes is the ragged edge of a zone, not a crack [-]
 MIN_EXTENT = 3.0
+#: relative tolerance on r_b for a boundary vertex to lie on the borehole wall [-]
+WALL_TOL = 1e-6
 
 
 def circle_crossings(a: np.ndarray, b: np.ndarray, center: np.ndarray, R: float) -> np.ndarray:
@@ -87,27 +104,32 @@ def local_mesh_size(a: np.ndarray, b: np.ndarray, center: np.ndarray, R: float) 
     return float(np.median(np.linalg.norm(b[hit] - a[hit], axis=1))) if hit.any() else 0.0
 
 
-def crossing_profile(a, b, cracked, tensile, center, radii) -> dict:
-    """N(R) of the cracked interfaces a→b and of the tensile ones, and the shattered arc length [m], at each radius.
+def crossing_profile(a, b, cracked, tensile, center, radii, connected=None) -> dict:
+    """N(R) of the connected cracked interfaces a→b and of their tensile ones, and the shattered arc [m], per radius.
 
-    ``cracked``, ``tensile``: masks over all interfaces; the merge gap and the narrow-arc limit scale with the
-    mesh size along each circle, so that a crack through coarse elements is not split into several. Narrow
+    ``cracked``, ``tensile``, ``connected``: masks over all interfaces (``connected`` None: all of them). N(R)
+    (``count``, ``count_tensile``) counts the interfaces that are cracked and connected; ``count_all`` and
+    ``shattered_arc`` use every cracked interface. The merge gap and the narrow-arc limit scale with the mesh
+    size along each circle, so that a crack through coarse elements is not split into several. Narrow
     crossings are linked into radial chains (:func:`persistent_counts`); only chains at least
     ``MIN_EXTENT`` local mesh sizes long count, which drops the ragged fringe of shattered zones.
     """
-    narrow_all, narrow_ten, shattered, sizes = [], [], [], []
+    connected = np.ones(len(a), bool) if connected is None else connected
+    masks = {"count": cracked & connected, "count_tensile": tensile & connected, "count_all": cracked}
+    narrow = {k: [] for k in masks}
+    shattered, sizes = [], []
     for R in radii:
         w = local_mesh_size(a, b, center, R)
-        g_all = group_crossings(circle_crossings(a[cracked], b[cracked], center, R), R, w)
-        g_ten = group_crossings(circle_crossings(a[tensile], b[tensile], center, R), R, w)
-        narrow_all.append([g[0] for g in g_all if g[1] <= NARROW_ARC * w])
-        narrow_ten.append([g[0] for g in g_ten if g[1] <= NARROW_ARC * w])
-        shattered.append(sum(g[1] for g in g_all if g[1] > NARROW_ARC * w))
+        for k, m in masks.items():
+            g = group_crossings(circle_crossings(a[m], b[m], center, R), R, w)
+            narrow[k].append([t for t, arc, _ in g if arc <= NARROW_ARC * w])
+            if k == "count_all":
+                shattered.append(sum(arc for _, arc, _ in g if arc > NARROW_ARC * w))
         sizes.append(w)
-    return {"radius": [float(r) for r in radii],
-            "count": persistent_counts(radii, narrow_all, sizes),
-            "count_tensile": persistent_counts(radii, narrow_ten, sizes),
-            "shattered_arc": [float(s) for s in shattered], "mesh_size": sizes}
+    out = {"radius": [float(r) for r in radii]}
+    out.update({k: persistent_counts(radii, narrow[k], sizes) for k in masks})
+    out.update({"shattered_arc": [float(s) for s in shattered], "mesh_size": sizes})
+    return out
 
 
 def persistent_counts(radii, angles: list[list[float]], sizes: list[float]) -> list[int]:
@@ -161,35 +183,130 @@ def lengths_from_profile(radii: np.ndarray, counts: np.ndarray, r_c: float) -> l
     return out
 
 
-def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) -> dict:
-    """Statistics of the cracks around the hole at ``center`` [m] of radius ``r_b`` [m] (SI units)."""
+def interface_vertices(model) -> np.ndarray:
+    """Mesh vertex ids of the two ends of each interface, shape [Q, 2] (node n is corner n % 3 of element n // 3)."""
     topo = model.topology
-    X = model.host["node_X"]
     pn = topo.pair_nodes
-    a = X[pn[0::2, 0]]                      # the two ends of each interface (side e1)
-    b = X[pn[1::2, 0]]
-    mid = 0.5 * (a + b)
-    r = np.linalg.norm(mid - center, axis=1)
-    L = np.linalg.norm(b - a, axis=1)
-    pair_mode = mode.reshape(-1, 2)
-    cracked = (pair_mode > 0).any(axis=1)
-    tensile = (pair_mode == 1).any(axis=1)
+    return np.stack([topo.node_vertex[pn[0::2, 0]], topo.node_vertex[pn[1::2, 0]]], axis=1)
+
+
+def vertex_components(ends: np.ndarray, cracked: np.ndarray, n_vertex: int) -> np.ndarray:
+    """Component label of each mesh vertex in the graph whose edges are the cracked interfaces, shape [V].
+
+    Two cracked interfaces share a label when a chain of cracked interfaces, each sharing a vertex with the
+    next, joins them; the label of an interface is that of either of its ends ``ends`` [Q, 2].
+    """
+    e = ends[cracked]
+    g = coo_matrix((np.ones(len(e), np.int8), (e[:, 0], e[:, 1])), shape=(n_vertex, n_vertex))
+    return connected_components(g, directed=False)[1]
+
+
+def wall_vertices(model, center: np.ndarray, r_b: float, w: float) -> np.ndarray:
+    """Mesh vertex ids on the wall of the hole of radius ``r_b`` [m] about ``center`` [m].
+
+    The wall is the mesh-boundary vertices at distance ≤ r_b·(1 + WALL_TOL); if there is none (a charge
+    without a borehole), the boundary vertices within r_b + w, w [m] being the ring width.
+    """
+    topo = model.topology
+    s = topo.boundary_slots                                   # slot 3e+k joins corners k and (k+1) % 3 of e
+    nodes = np.concatenate([s, 3 * (s // 3) + (s % 3 + 1) % 3])
+    d = np.linalg.norm(model.host["node_X"][nodes] - center, axis=1)
+    on = d <= r_b * (1.0 + WALL_TOL)
+    if not on.any():
+        on = d <= r_b + w
+    return np.unique(topo.node_vertex[nodes[on]])
+
+
+def ring_width(L: np.ndarray, r: np.ndarray, r_b: float) -> float:
+    """Median length [m] of the interfaces (lengths L, midpoint radii r) within 2 r_b of the centre."""
     near = r < 2.0 * r_b
-    w = float(np.median(L[near])) if near.any() else float(np.median(L))
-    # crushed zone: consecutive rings from the wall with at least half of the interfaces cracked
+    return float(np.median(L[near])) if near.any() else float(np.median(L))
+
+
+def crushed_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float, w: float) -> float:
+    """Crushed-zone radius r_c [m]: outer radius of the rings of width w [m] from the wall, each ≥ half cracked.
+
+    ``r``: midpoint radius of each interface [m]; ``cracked``: mask over the interfaces.
+    """
     r_c, k = r_b, 0
     while True:
         ring = (r >= r_b + k * w) & (r < r_b + (k + 1) * w)
         if ring.sum() == 0 or cracked[ring].mean() < 0.5:
-            break
+            return r_c
         k += 1
         r_c = r_b + k * w
+
+
+def connected_network(model, cracked: np.ndarray, center: np.ndarray, r_b: float) -> dict:
+    """The crack network of one hole: ring width w, r_c [m], and per interface its set label and connected mask.
+
+    Returns ``w``, ``r_c``, ``label`` (crack-set label of each interface, meaningful where cracked),
+    ``connected`` (cracked and in a set with a vertex on the wall, or at r ≤ r_c when r_c > r_b), ``wall``
+    (the wall's mesh vertex ids) and ``length`` (interface lengths [m]).
+    """
+    X = model.host["node_X"]
+    pn = model.topology.pair_nodes
+    a, b = X[pn[0::2, 0]], X[pn[1::2, 0]]
+    L = np.linalg.norm(b - a, axis=1)
+    r = np.linalg.norm(0.5 * (a + b) - center, axis=1)
+    w = ring_width(L, r, r_b)
+    r_c = crushed_zone_radius(r, cracked, r_b, w)
+    ends = interface_vertices(model)
+    label = vertex_components(ends, cracked, len(model.mesh.vertices))[ends[:, 0]]
+    wall = wall_vertices(model, center, r_b, w)
+    seed = cracked & np.isin(ends, wall).any(axis=1)
+    if r_c > r_b:
+        r_end = np.minimum(np.linalg.norm(a - center, axis=1), np.linalg.norm(b - center, axis=1))
+        seed |= cracked & (r_end <= r_c)
+    connected = cracked & np.isin(label, label[seed])
+    return {"w": w, "r_c": r_c, "label": label, "connected": connected, "wall": wall, "length": L}
+
+
+def detached_sets(label: np.ndarray, length: np.ndarray, detached: np.ndarray) -> dict:
+    """Number of detached crack sets, their total length [m] and the number of sets of more than MIN_EXTENT interfaces.
+
+    A set of n interfaces is longer than MIN_EXTENT times its mean interface length (its local mesh size)
+    exactly when n > MIN_EXTENT.
+    """
+    _, n = np.unique(label[detached], return_counts=True)
+    return {"detached_crack_sets": int(len(n)), "detached_crack_length": float(length[detached].sum()),
+            "detached_crack_sets_long": int(np.sum(n > MIN_EXTENT))}
+
+
+def detached_interface_mask(model, mode: np.ndarray, holes) -> np.ndarray:
+    """Cracked interfaces connected to none of the holes ``holes`` [(center [m], r_b [m]), ...], mask [Q].
+
+    ``crack_segments`` (io.paraview) lists the cracked interfaces in index order, so
+    ``mask[cracked]`` is the matching per-segment mask.
+    """
+    cracked = (mode.reshape(-1, 2) > 0).any(axis=1)
+    attached = np.zeros_like(cracked)
+    for c, r_b in holes:
+        attached |= connected_network(model, cracked, np.asarray(c, float), float(r_b))["connected"]
+    return cracked & ~attached
+
+
+def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) -> dict:
+    """Statistics of the cracks around the hole at ``center`` [m] of radius ``r_b`` [m] (SI units).
+
+    N(R), the radial crack count and lengths count only the crack network connected to this hole's wall
+    (or to its crushed zone); the other crack sets are reported as detached (``detached_*``). With several
+    boreholes this is called once per hole, and a crack set joined only to another hole is detached here.
+    """
+    X = model.host["node_X"]
+    pn = model.topology.pair_nodes
+    a, b = X[pn[0::2, 0]], X[pn[1::2, 0]]       # the two ends of each interface (side e1)
+    pair_mode = mode.reshape(-1, 2)
+    cracked = (pair_mode > 0).any(axis=1)
+    tensile = (pair_mode == 1).any(axis=1)
+    net = connected_network(model, cracked, center, r_b)
+    w, r_c, connected = net["w"], net["r_c"], net["connected"]
     # crack crossings of circles outside the crushed zone
     r_max = float(np.linalg.norm(np.concatenate([a, b]) - center, axis=1).max())
     radii = np.arange(r_c + 2 * w, r_max, w)
     if len(radii) > 400:                     # keep the profile short on big meshes
         radii = np.linspace(radii[0], radii[-1], 400)
-    prof = crossing_profile(a, b, cracked, tensile, center, radii)
+    prof = crossing_profile(a, b, cracked, tensile, center, radii, connected)
     counts = np.asarray(prof["count"], int)
     lengths = lengths_from_profile(radii, counts, r_c)
     n_rad = int(counts.max(initial=0))
@@ -206,5 +323,10 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
         "radial_crack_lengths": lengths,
         "longest_radial_crack": max(lengths) if lengths else 0.0,
         "mean_radial_crack_length": float(np.mean(lengths)) if lengths else 0.0,
+        "wall_vertices": int(len(net["wall"])),
+        "cracked_interfaces": int(cracked.sum()),
+        "connected_interfaces": int(connected.sum()),
+        "connected_crack_length": float(net["length"][connected].sum()),
+        **detached_sets(net["label"], net["length"], cracked & ~connected),
         "crossings": prof,
     }

@@ -20,9 +20,19 @@ TENSILE_COLOR = "#d62728"
 SHEAR_COLOR = "#1f77b4"
 
 
+TENSILE_DETACHED_COLOR = "#f0a8a8"
+SHEAR_DETACHED_COLOR = "#a9c8e6"
+
+
 def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarray, title: str = "",
-                     show_mesh: bool = True, circles=()) -> None:
-    """Deformed mesh (light) with tensile (red) and shear (blue) cracks."""
+                     show_mesh: bool = True, circles=(), detached: np.ndarray | None = None) -> None:
+    """Deformed mesh (light) with tensile (red) and shear (blue) cracks; detached cracks in lighter shades.
+
+    ``seg`` [K, 2], ``mode`` [K]: the cracked interfaces and their mode (io.paraview.crack_segments); the
+    legend counts cracked interfaces (summary.json → broken_springs counts springs, up to two per interface).
+    ``detached`` [K] (optional): the segments in crack sets connected to no borehole
+    (analysis.cracks.detached_interface_mask, indexed by the cracked interfaces).
+    """
     plt = _plt()
     from matplotlib.collections import LineCollection
 
@@ -31,10 +41,15 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     if show_mesh:
         edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
         ax.add_collection(LineCollection(x[edges], colors="0.82", linewidths=0.2))
-    for code, color, label in ((1, TENSILE_COLOR, "tensile"), (2, SHEAR_COLOR, "shear")):
-        s = seg[mode == code]
+    det = np.zeros(len(seg), bool) if detached is None else np.asarray(detached, bool)
+    styles = ((1, False, TENSILE_COLOR, "tensile"), (2, False, SHEAR_COLOR, "shear"),
+              (1, True, TENSILE_DETACHED_COLOR, "tensile, detached"),
+              (2, True, SHEAR_DETACHED_COLOR, "shear, detached"))
+    for code, off, color, label in styles:
+        s = seg[(mode == code) & (det == off)]
         if len(s):
-            ax.add_collection(LineCollection(x[s], colors=color, linewidths=0.9, label=f"{label} ({len(s)})"))
+            ax.add_collection(LineCollection(x[s], colors=color, linewidths=0.9 if not off else 0.7,
+                                             label=f"{label} ({len(s)})", zorder=2 if not off else 1))
     for c, r in circles:
         ax.add_patch(plt.Circle(c, r, fill=False, color="k", lw=0.6))
     ax.set_xlim(x[:, 0].min(), x[:, 0].max())
@@ -44,7 +59,8 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     ax.set_ylabel("y [m]")
     ax.set_title(title or "Fracture pattern", fontsize=9, wrap=True)
     if len(seg):
-        ax.legend(loc="upper right", fontsize=8)
+        head = "cracked interfaces" + ("" if detached is None else " (detached: not joined to a hole)")
+        ax.legend(loc="upper right", fontsize=8, title=head, title_fontsize=8)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
@@ -185,9 +201,11 @@ def fracture_degree_zones(path: Path, t: np.ndarray, cols: dict[str, np.ndarray]
 
 
 def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
-    """Radial cracks crossing circles about each hole, N(R), and the shattered fraction of each circle.
+    """Cracks connected to each hole crossing circles about it, N(R), and the shattered fraction of each circle.
 
-    ``stats``: the entries of summary.json → cracks (analysis.cracks.crack_statistics), one per hole.
+    ``stats``: the entries of summary.json → cracks (analysis.cracks.crack_statistics), one per hole. N(R)
+    counts only the crack network joined to the hole's wall or crushed zone; the detached crack sets are
+    drawn as a light line (``count_all``, all cracked interfaces) and summed up in the legend.
     """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 4), dpi=150)
@@ -196,8 +214,11 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
         p = s["crossings"]
         R = np.asarray(p["radius"]) / s["borehole_radius"]
         lab = f" (hole {i})" if len(stats) > 1 else ""
-        ax.plot(R, p["count"], color="k", label=f"all cracks{lab}")
-        ax.plot(R, p["count_tensile"], color=TENSILE_COLOR, ls="--", label=f"tensile{lab}")
+        ax.plot(R, p["count"], color="k", label=f"connected to the hole{lab}")
+        ax.plot(R, p["count_tensile"], color=TENSILE_COLOR, ls="--", label=f"connected, tensile{lab}")
+        if "count_all" in p:
+            ax.plot(R, p["count_all"], color="0.6", lw=0.8, label=f"all cracks incl. detached{lab}: "
+                    f"{_detached_note(s)}")
         frac = np.asarray(p["shattered_arc"]) / (2 * np.pi * np.asarray(p["radius"]))
         ax2.fill_between(R, 0, np.minimum(frac, 1.0), color="0.6", alpha=0.3, lw=0)
         ax.axvline(s["crushed_zone_radius_over_rb"], color=SHEAR_COLOR, lw=0.8, ls=":")
@@ -207,8 +228,16 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
     ax2.set_ylim(0, 1)
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right")
-    ax.set_title(title or "Radial cracks (dotted: crushed-zone radius)", fontsize=10)
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(title or "Radial cracks connected to the hole (dotted: crushed-zone radius)", fontsize=10)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def _detached_note(s: dict) -> str:
+    """Legend text for the detached crack sets of one crack_statistics entry."""
+    if "detached_crack_sets" not in s:
+        return "detached sets not computed"
+    return (f"{s['detached_crack_sets']} detached sets ({s['detached_crack_sets_long']} with > 3 interfaces), "
+            f"{s['detached_crack_length'] * 1e3:.0f} mm in all")
