@@ -56,7 +56,7 @@ class Simulation:
         self.alpha = scenario.simulation.damping
         X = self.model.host["node_X"]
         self.fracture = FractureDegree(X[self.model.topology.pair_nodes[:, 0]], scenario.zones)
-        self.monitors = MonitorSet(scenario.monitors, X)
+        self.monitors = MonitorSet(scenario.monitors, X, self.model.host["node_mass"])
         self.insitu_report: dict | None = None
         self.initial_stored = 0.0
 
@@ -317,8 +317,10 @@ class Simulation:
                                "total": counts["tensile"] + counts["shear"]},
             "fracture_degree": self.fracture.sample(mode),
             "energy": {**e, "initial_stored": self.initial_stored, "budget_error": err, "budget_error_relative": rel},
+            "elastic": m.elastic.as_dict(),
             "insitu_stage": self.insitu_report,
             "cracks": self.crack_statistics(),
+            "monitors": self.monitors.report(),
         }
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
@@ -329,6 +331,11 @@ class Simulation:
         """Crushed-zone radius, radial crack count and lengths around each borehole (analysis.cracks)."""
         from .analysis.cracks import crack_statistics
 
+        mode = self.state.pair_mode.numpy()
+        return [crack_statistics(self.model, mode, np.asarray(c, float), r) for c, r in self.crack_centres()]
+
+    def crack_centres(self) -> list[tuple[tuple[float, float], float]]:
+        """(centre [m], radius [m]) about which cracks are counted: the boreholes, else the charges."""
         centres = [(b.center, b.radius) for b in self.scenario.geometry.boreholes]
         if not centres and self.scenario.explosive is not None:
             from .mpm.seeding import charge_area_centroid, charge_bbox
@@ -336,19 +343,24 @@ class Simulation:
             for c in self.scenario.explosive.charges:
                 lo, hi = charge_bbox(c)
                 centres.append((tuple(charge_area_centroid(c)[1]), 0.5 * float(np.min(hi - lo))))
-        mode = self.state.pair_mode.numpy()
-        return [crack_statistics(self.model, mode, np.asarray(c, float), r) for c, r in centres]
+        return centres
 
     def write_figures(self, mon: CsvHistory, frac: CsvHistory, energy: CsvHistory, cracks: list[dict] | None = None) -> None:
         from .plot import figures
 
         x = self.state.x.numpy()
-        seg, cmode = crack_segments(self.model, self.state.pair_mode.numpy(), self.state.pair_tbreak.numpy())
+        from .analysis.cracks import detached_interface_mask
+
+        pm = self.state.pair_mode.numpy()
+        seg, cmode = crack_segments(self.model, pm, self.state.pair_tbreak.numpy())
         circles = [(b.center, b.radius) for b in self.scenario.geometry.boreholes]
+        holes = self.crack_centres()
+        detached = (detached_interface_mask(self.model, pm, holes)[(pm.reshape(-1, 2) > 0).any(axis=1)]
+                    if holes else None)
         title = self.scenario.title or "blastfrac"
         figures.fracture_pattern(self.out_dir / "fracture_pattern.png", x, seg, cmode,
                                  title=f"{title}: cracks at t = {self.time * 1e6:.1f} µs",
-                                 show_mesh=self.model.element_count <= 60_000, circles=circles)
+                                 show_mesh=self.model.element_count <= 60_000, circles=circles, detached=detached)
         figures.displacement_map(self.out_dir / "displacement.png", x, x - self.model.host["node_X"],
                                  title=f"{title}: |u| at t = {self.time * 1e6:.1f} µs")
         if self.snapshots:
