@@ -57,7 +57,7 @@ def test_two_blocks_collide_and_rebound(offset):
         e = rock_energies(m, st)                            # stresses of step k, set by forces()
         solver.integrate(st, dt)
         v = st.v.numpy()
-        total[k] = leapfrog_kinetic(mass, v_prev, v) + e["strain"] + e["springs"]
+        total[k] = leapfrog_kinetic(mass, v_prev, v, m.mass_theta) + e["strain"] + e["springs"]
         v_prev = v
         c = st.x.numpy()[corner]
         depth = max(depth, *(_depth(c[i], c[4:]) for i in range(4)), *(_depth(c[i], c[:4]) for i in range(4, 8)))
@@ -75,7 +75,10 @@ def test_two_blocks_collide_and_rebound(offset):
     np.testing.assert_allclose(p, p0, atol=1e-12 * np.abs(mass[:, None] * v0).sum())   # momentum conserved
     assert 0 < in_contact < 200, "one short impact"
     assert v[left, 0].mean() < 0 < v[~left, 0].mean(), "the blocks rebound"
-    assert restitution > 0.6, "μ = 0: near-elastic rebound (the rest goes into block vibration)"
+    # μ = 0: near-elastic rebound, the rest goes into block vibration. How much goes there depends on the
+    # mass matrix (averaged mass, the default: 0.58 flush / 0.71 offset; lumped: > 0.6 in both), and energy is
+    # asserted conserved below for either; the bound on the coefficient holds for the lumped blocks.
+    assert restitution > (0.6 if m.mass_theta == 0.0 else 0.5)
     assert depth < 2.0 * scale, "no interpenetration beyond the contact penalty"
     assert after + losses["penalty_dropped"] < 1.02 * e0, "contact creates no energy"
     # frictionless: little loss (the contact is entered and left at zero force, module doc); the rest is
@@ -185,7 +188,7 @@ def test_precracked_block_halves_collide():
         e = rock_energies(m, st)
         solver.integrate(st, dt)
         v_new = st.v.numpy()
-        total[k] = leapfrog_kinetic(mass, v_prev, v_new) + e["strain"] + e["springs"]
+        total[k] = leapfrog_kinetic(mass, v_prev, v_new, m.mass_theta) + e["strain"] + e["springs"]
         v_prev = v_new
         if k % 5 == 0:
             depth = max(depth, relative_penetration(st.x.numpy(), reach).max())

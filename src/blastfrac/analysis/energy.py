@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.builder import _cross
+from ..cdem.kernels_integrate import block_kinetic_energy
 from ..model.model import CONTACT_DISSIPATED, DAMPING_DISSIPATED, EXTERNAL_WORK, VISCOUS_ABSORBED
 
 
@@ -41,7 +42,7 @@ def rock_energies(model, state) -> dict[str, float]:
     fracture = float(efrac[broken].sum() + np.sum((work - stored)[~broken]))
     friction = float(np.sum((work - stored - efrac)[broken])) + float(acc[CONTACT_DISSIPATED])
     return {
-        "kinetic": float(0.5 * np.sum(m * np.einsum("ij,ij->i", v, v))),
+        "kinetic": block_kinetic_energy(m, v, model.mass_theta),
         "strain": float(np.sum(strain_energy_density(sig, model.lam, model.mu) * area)),
         "springs": float(stored.sum()),
         "fracture": fracture,

@@ -769,4 +769,4 @@ class BlockContact:
         nodes = np.arange(m.node_count)
         trib = 0.5 * (lengths[nodes] + lengths[3 * (nodes // 3) + (nodes % 3 + 2) % 3])
         row += 2.0 * self.kn_area * trib
-        return 2.0 / math.sqrt(float(np.max(row / h["node_mass"])))
+        return 2.0 / math.sqrt(float(np.max(row / h["node_mass_dt"])))

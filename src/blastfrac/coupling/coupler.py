@@ -96,7 +96,7 @@ class GasRockCoupler:
         L = self.model.mesh.edge_lengths()                              # [E, 3], edge k runs k → k+1
         adj = np.stack([L[:, 0] + L[:, 2], L[:, 1] + L[:, 0], L[:, 2] + L[:, 1]], 1).reshape(-1)
         r_p = max(self.r_p0, 1e-12)
-        om2_r = float(np.max(self.kc * np.maximum(adj / (2.0 * r_p), 1.0) / self.model.host["node_mass"]))
+        om2_r = float(np.max(self.kc * np.maximum(adj / (2.0 * r_p), 1.0) / self.model.host["node_mass_dt"]))
         return 2.0 / math.sqrt(max(om2_p, om2_r))
 
     def lever_stiffness_factor(self) -> float:

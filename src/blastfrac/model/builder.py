@@ -17,6 +17,10 @@ from .model import Model
 from .topology import Topology, build_topology
 
 
+#: consistent-mass fraction θ of each rock.mass_matrix choice
+MASS_THETA = {"lumped": 0.0, "averaged": 0.5, "consistent": 1.0}
+
+
 class ModelBuilder:
     """Host-side assembly of the rock model; ``finalize(device)`` moves it to a Warp device."""
 
@@ -36,6 +40,10 @@ class ModelBuilder:
         h = {}
         h["node_X"] = X
         h["node_mass"] = np.repeat(rock.density * area / 3.0, 3)
+        # θ of the block mass matrices and the smallest eigen-mass per node, m(1 − 3θ/4), which bounds every
+        # stable-step estimate (M_e ≥ m(1 − 3θ/4)·I, cdem/kernels_integrate.py)
+        self.mass_theta = MASS_THETA[rock.mass_matrix]
+        h["node_mass_dt"] = h["node_mass"] * (1.0 - 0.75 * self.mass_theta)
         h["elem_area0"] = area
 
         # springs
@@ -147,7 +155,7 @@ class ModelBuilder:
         for col in (0, 1):
             np.add.at(row[:, 0], pn[:, col], rx)
             np.add.at(row[:, 1], pn[:, col], ry)
-        omega2 = np.max(row / h["node_mass"][:, None])
+        omega2 = np.max(row / h["node_mass_dt"][:, None])
         # a dashpot of ratio ζ on the stiffest mode lowers the central-difference limit to
         # (2/ω)(√(1+ζ²) − ζ) (Belytschko, Liu & Moran, Nonlinear FE, §6.3)
         zeta = self.scenario.rock.spring_damping
@@ -197,6 +205,7 @@ class ModelBuilder:
             stable_dt=self.stable_dt,
             host=h,
             elastic=self.elastic,
+            mass_theta=self.mass_theta,
         )
         return m
 

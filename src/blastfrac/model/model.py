@@ -74,6 +74,7 @@ class Model:
     q_lin: float = 0.0
     spring_damping: float = 0.0
     host: dict = field(default_factory=dict)
+    mass_theta: float = 0.0   # consistent-mass fraction θ of the block mass matrices (cdem/kernels_integrate.py)
     elastic: object = None    # model.compliance.ElasticReport: input, block and assembly moduli
 
     @property
