@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -229,7 +230,7 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
-    ax.set_title(title or "Radial cracks connected to the hole (dotted: crushed-zone radius)", fontsize=10)
+    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius)", 90), fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
