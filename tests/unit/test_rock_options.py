@@ -83,3 +83,33 @@ def test_block_mass_matrix_rigid_mass_and_smallest_eigen_mass(theta):
     v = np.random.default_rng(1).normal(size=(3, 2))
     ke = 0.5 * sum(v[:, d] @ M @ v[:, d] for d in range(2))
     assert block_kinetic_energy(np.full(3, m), v, theta) == pytest.approx(ke, rel=1e-12)
+
+
+@pytest.mark.parametrize("mass_matrix", ["lumped", "averaged"])
+def test_stable_step_is_below_the_exact_critical_step(mass_matrix):
+    """The builder's Gershgorin step (compensated blocks, penalty springs, the mass matrix's smallest
+    eigen-mass) must not exceed 2/ω_max of the model's own generalized eigenproblem K x = ω² M x, solved
+    exactly here on a small mesh; and it should not be needlessly small (> 40 % of it)."""
+    import scipy.linalg as sla
+
+    from blastfrac.calibration.elastic import stiffness_matrix
+    from blastfrac.model.builder import MASS_THETA, ModelBuilder
+
+    sc = scenario_from_dict({"rock": {"unbreakable": True, "mass_matrix": mass_matrix},
+                             "geometry": {"domain": {"type": "rectangle", "width": 0.03, "height": 0.02},
+                                          "mesh_size": 0.003}})
+    m = ModelBuilder(sc).finalize("cpu")
+    K = stiffness_matrix(m).toarray()
+    theta = MASS_THETA[mass_matrix]
+    mn = m.host["node_mass"]
+    M = np.zeros_like(K)
+    for e in range(m.element_count):
+        Me = mn[3 * e] * ((1 - 0.75 * theta) * np.eye(3) + 0.25 * theta * np.ones((3, 3)))
+        for d in range(2):
+            idx = 2 * (3 * e + np.arange(3)) + d
+            M[np.ix_(idx, idx)] = Me
+    omega_max = math.sqrt(sla.eigh(K, M, eigvals_only=True, subset_by_index=[K.shape[0] - 1, K.shape[0] - 1])[0])
+    dt_exact = 2.0 / omega_max
+    print(f"\n  {mass_matrix}: Gershgorin {m.stable_dt:.4e} s, exact {dt_exact:.4e} s ({m.stable_dt / dt_exact:.2f})")
+    assert m.stable_dt <= dt_exact
+    assert m.stable_dt > 0.4 * dt_exact

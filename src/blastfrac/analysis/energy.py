@@ -20,7 +20,7 @@ def strain_energy_density(sig: np.ndarray, lam: float, mu: float) -> np.ndarray:
 def rock_energies(model, state) -> dict[str, float]:
     """All energy terms of the rock at the current step.
 
-    kinetic: ½mv² with the half-step velocities; strain: blocks (current area);
+    kinetic: ½vᵀMv with the half-step velocities and the blocks' mass matrices (cdem/kernels_integrate.py); strain: blocks (current area);
     springs: ½Fn²/Kn + ½Fs²/Ks of every spring still carrying force;
     fracture: energy dissipated by broken springs at failure plus softening in progress;
     friction: other dissipation in broken springs (sliding) and block contact;

@@ -23,6 +23,7 @@ With θ = 0 this is the former node-by-node update exactly.
 
 from __future__ import annotations
 
+import numpy as np
 import warp as wp
 
 
@@ -134,8 +135,6 @@ def launch_integrate(model, state, dt: float, alpha: float) -> None:
 
 def block_kinetic_energy(m, v, theta: float) -> float:
     """½ vᵀ M v [J/m] of all blocks with the mass matrix of the module doc (NumPy; m: node masses [N], v [N, 2])."""
-    import numpy as np
-
     m = np.asarray(m, float)
     v = np.asarray(v, float)
     a = m[0::3] * (1.0 - 0.75 * theta)
