@@ -59,17 +59,21 @@ def gas_energies(gas) -> dict[str, float]:
     Particles that left the grid keep their last state, so their energy stays in the books.
     explosive_released: Σ F·E0·V0 (chemical energy liberated by the burn so far);
     gas_internal: Σ ie − Σ (1 − F)·E0·V0 (internal energy of the burnt products);
-    gas_kinetic: Σ ½ m v².
+    gas_kinetic: Σ ½ m v², plus with APIC transfer the affine part Σ ½ m tr(B D⁻¹ Bᵀ) of the active particles
+    (mpm/apic.py; a particle that left the grid has no affine field).
     """
     P = gas.material
     ie = gas.ie.numpy()
     burn = gas.burn.numpy()
     chem0 = P.E0 * gas.vol0.numpy()
     v = gas.v.numpy()
+    ke = float(0.5 * (gas.mass.numpy() * np.einsum("ij,ij->i", v, v)).sum())
+    if getattr(gas, "apic", False):
+        ke += gas.energies()["kinetic_affine"]
     return {
         "explosive_released": float((burn * chem0).sum()),
         "gas_internal": float(ie.sum() - ((1.0 - burn) * chem0).sum()),
-        "gas_kinetic": float(0.5 * (gas.mass.numpy() * np.einsum("ij,ij->i", v, v)).sum()),
+        "gas_kinetic": ke,
     }
 
 

@@ -48,6 +48,59 @@ def g2p_velocity(
 
 
 @wp.kernel
+def g2p_velocity_apic(
+    x: wp.array(dtype=wp.vec2d),
+    active: wp.array(dtype=wp.int32),
+    g_vel: wp.array(dtype=wp.vec2d),
+    x0: wp.float64,
+    y0: wp.float64,
+    inv_h: wp.float64,
+    nx: int,
+    ny: int,
+    px: int,
+    py: int,
+    kind: int,
+    l: wp.float64,
+    vol: wp.array(dtype=wp.float64),
+    vol0: wp.array(dtype=wp.float64),
+    v_max: wp.float64,
+    v: wp.array(dtype=wp.vec2d),
+    v_pic: wp.array(dtype=wp.vec2d),
+    b_aff: wp.array(dtype=wp.mat22d),
+):
+    """APIC: v_p = v_pic = sum N v_I [m/s]; affine moment B_p = sum N v_I (x) (x_I - x_p) [m^2/s] (the next P2G
+    uses C_p = B_p D_p^-1); see :mod:`blastfrac.mpm.apic`.
+
+    Guard: B_p = 0 once V_p > v_max V_p0 (vol, vol0 [m^2]; the products' pressure is frozen there, METHOD §2.7).
+    A point alone on its nodes gets its own affine field back from them, so its C_p, hence its volume rate
+    tr C_p, never decays and its volume grows exponentially (to overflow in a slab expanding into vacuum).
+    """
+    p = wp.tid()
+    if active[p] == 0:
+        return
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    h = F64(1.0) / inv_h
+    fx = (x[p][0] - x0) * inv_h
+    fy = (x[p][1] - y0) * inv_h
+    vp = wp.vec2d()
+    Bm = wp.mat22d()
+    for i in range(3):
+        ii = wrap_index(bx + i, nx, px)
+        for j in range(3):
+            n = wrap_index(by + j, ny, py) * nx + ii
+            N = wx[i] * wy[j]
+            dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
+            vI = g_vel[n]
+            vp += N * vI
+            Bm += N * wp.outer(vI, dx)
+    v[p] = vp
+    v_pic[p] = vp
+    if vol[p] > v_max * vol0[p]:
+        Bm = wp.mat22d()
+    b_aff[p] = Bm
+
+
+@wp.kernel
 def update_particle_kinematics(
     active: wp.array(dtype=wp.int32),
     mass: wp.array(dtype=wp.float64),

@@ -2,12 +2,15 @@
 
 Scatter with ``wp.atomic_add`` inside a single launch (safe on CPU and CUDA).
 Arguments: particle arrays, grid geometry scalars, then grid outputs (zeroed by the launcher).
+The momentum carries each particle's affine velocity C_p = B_p D_p^-1 (APIC, :mod:`blastfrac.mpm.apic`);
+with the FLIP/PIC transfer B_p stays 0 and the sums are bit for bit those without it.
 """
 
 from __future__ import annotations
 
 import warp as wp
 
+from blastfrac.mpm.apic import affine_from_moments, affine_inertia
 from blastfrac.mpm.shape import stencil_1d, wrap_index
 
 F64 = wp.float64
@@ -25,6 +28,7 @@ def particle_stencil(x: wp.vec2d, x0: wp.float64, y0: wp.float64, inv_h: wp.floa
 def p2g(
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
+    b_aff: wp.array(dtype=wp.mat22d),
     mass: wp.array(dtype=wp.float64),
     vol: wp.array(dtype=wp.float64),
     stress: wp.array(dtype=wp.mat22d),
@@ -44,7 +48,8 @@ def p2g(
     g_mom: wp.array(dtype=wp.vec2d),
     g_force: wp.array(dtype=wp.vec2d),
 ):
-    """m_I += N m_p; p_I += N m_p v_p; f_I += -V_p sigma_p grad N + N f_ext_p + M_p grad N (per unit thickness).
+    """m_I += N m_p; p_I += N m_p (v_p + C_p (x_I − x_p)); f_I += -V_p sigma_p grad N + N f_ext_p + M_p grad N
+    (per unit thickness; C_p = B_p D_p^-1 [1/s] the APIC affine velocity, 0 with FLIP/PIC).
 
     M_p = Σ_k f_k ⊗ (x_k − x_p) [N] is the first moment of the external forces f_k that act at points x_k other
     than the particle centre (contact tractions on the particle's surface): N_I(x_k) ≈ N_I(x_p) + ∇N_I·(x_k − x_p).
@@ -58,14 +63,19 @@ def p2g(
     vs = vol[p] * stress[p]
     fe = f_ext[p]
     ms = f_ext_moment[p] - vs
+    h = F64(1.0) / inv_h
+    fx = (x[p][0] - x0) * inv_h
+    fy = (x[p][1] - y0) * inv_h
+    Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
     for i in range(3):
         ii = wrap_index(bx + i, nx, px)
         for j in range(3):
             n = wrap_index(by + j, ny, py) * nx + ii
             N = wx[i] * wy[j]
             grad = wp.vec2d(dwx[i] * wy[j] * inv_h, wx[i] * dwy[j] * inv_h)
+            dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
             wp.atomic_add(g_mass, n, N * m)
-            wp.atomic_add(g_mom, n, N * mv)
+            wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))
             wp.atomic_add(g_force, n, N * fe + ms * grad)
 
 
@@ -73,6 +83,7 @@ def p2g(
 def p2g_momentum(
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
+    b_aff: wp.array(dtype=wp.mat22d),
     mass: wp.array(dtype=wp.float64),
     active: wp.array(dtype=wp.int32),
     x0: wp.float64,
@@ -86,14 +97,22 @@ def p2g_momentum(
     l: wp.float64,
     g_mom: wp.array(dtype=wp.vec2d),
 ):
-    """MUSL remap: p_I = sum N m_p v_p with the updated particle velocities [N s/m]."""
+    """MUSL remap: p_I = sum N m_p (v_p + C_p (x_I − x_p)), C_p = B_p D_p^-1, with the updated particle velocities
+    and affine moments [N s/m]."""
     p = wp.tid()
     if active[p] == 0:
         return
     bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
-    mv = mass[p] * v[p]
+    m = mass[p]
+    mv = m * v[p]
+    h = F64(1.0) / inv_h
+    fx = (x[p][0] - x0) * inv_h
+    fy = (x[p][1] - y0) * inv_h
+    Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
     for i in range(3):
         ii = wrap_index(bx + i, nx, px)
         for j in range(3):
             n = wrap_index(by + j, ny, py) * nx + ii
-            wp.atomic_add(g_mom, n, (wx[i] * wy[j]) * mv)
+            N = wx[i] * wy[j]
+            dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
+            wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))

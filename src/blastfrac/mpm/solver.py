@@ -5,7 +5,7 @@ One step (``step``) is four stages that a coupled simulation may interleave:
 1. ``to_grid(dt)``       P2G: node mass, momentum, internal force -V sigma grad N and the
                           external particle forces ``f_ext_p`` (N per unit thickness);
 2. ``update_grid(dt)``   mass cut-off, p_I += dt f_I, boundary conditions;
-3. ``to_particles(dt)``  G2P FLIP/PIC blend, MUSL remap of momentum, velocity gradient,
+3. ``to_particles(dt)``  G2P (FLIP/PIC blend or APIC), MUSL remap of momentum, velocity gradient,
                           volume/density update, particle motion (particles leaving the grid
                           are deactivated);
 4. ``update_eos(dt, t)`` burn fraction at t + dt, artificial viscosity, JWL energy/pressure,
@@ -26,11 +26,18 @@ from blastfrac._warp import resolve_device
 from blastfrac.materials.cj import cj_state
 from blastfrac.materials.jwl import JWLParams, jwl_sound_speed_sq_np
 from blastfrac.materials.linear_elastic_mp import LinearElasticMP, strain_energy_density_np, update_elastic_state
+from blastfrac.mpm.apic import (
+    TRANSFERS,
+    affine_angular_momentum_np,
+    affine_from_moments_np,
+    affine_inertia_np,
+    affine_kinetic_energy_np,
+)
 from blastfrac.mpm.burn import BURN_MODES, lighting_times
 from blastfrac.mpm.grid import Grid, GridSpec
 from blastfrac.mpm.kernels_burn import update_burn
 from blastfrac.mpm.kernels_eos import update_jwl_state
-from blastfrac.mpm.kernels_g2p import g2p_velocity, update_particle_kinematics
+from blastfrac.mpm.kernels_g2p import g2p_velocity, g2p_velocity_apic, update_particle_kinematics
 from blastfrac.mpm.kernels_grid import fold_wall_images, set_wall_ghosts, update_grid_momentum, velocity_from_momentum
 from blastfrac.mpm.kernels_misc import max_signal_speed
 from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
@@ -46,6 +53,7 @@ class MPMOptions:
 
     shape: str = "bspline2"
     ppc: int = 2
+    transfer: str = "flip"
     flip: float = 1.0
     cfl: float = 0.2
     q1: float = 1.5
@@ -75,7 +83,8 @@ class MPMSolver:
     """Explicit MUSL MPM for JWL detonation products (or a linear-elastic solid, for tests).
 
     Particle arrays (shape [n]): x, v, v_pic [m/s], f_ext_p [N/m] (vec2d); f_ext_moment [N] (mat22d: first
-    moment Σ f ⊗ (x_f − x_p) of external forces applied off the particle centre, see ``p2g``); mass [kg/m];
+    moment Σ f ⊗ (x_f − x_p) of external forces applied off the particle centre, see ``p2g``); b_aff [m^2/s]
+    (mat22d: the APIC affine moment B_p, C_p = B_p D_p⁻¹, :mod:`blastfrac.mpm.apic`; stays 0 with FLIP/PIC); mass [kg/m];
     vol, vol0, vol_prev [m^2]; rho [kg/m^3]; ie [J/m] (JWL internal energy; elastic solid: the work
     done on it); p, q [Pa]; burn [-]; light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32).
     Grid arrays: ``self.grid`` (:class:`Grid`).
@@ -89,6 +98,7 @@ class MPMSolver:
         opts = MPMOptions(
             shape=config.shape,
             ppc=config.grid.points_per_cell,
+            transfer=config.transfer,
             flip=config.flip,
             cfl=config.cfl,
             q1=config.q1,
@@ -142,6 +152,9 @@ class MPMSolver:
         self.n = n
         rho0 = material.rho0
         self.shape_kind = SHAPE_IDS[opts.shape]
+        if opts.transfer not in TRANSFERS:
+            raise ValueError(f"unknown velocity transfer '{opts.transfer}' (one of {', '.join(TRANSFERS)})")
+        self.apic = opts.transfer == "apic"
         self.shape_l = 0.5 / opts.ppc  # uGIMP l_p / h
         self.m_cut = opts.mass_cutoff * rho0 * spec.h**2
         d = self.device
@@ -153,6 +166,7 @@ class MPMSolver:
         self.v = wp.array(np.zeros((n, 2)) if v is None else np.asarray(v, F64), dtype=wp.vec2d, device=d)
         self.v_pic, self.f_ext_p = z(wp.vec2d), z(wp.vec2d)
         self.f_ext_moment = z(wp.mat22d)
+        self.b_aff = z(wp.mat22d)
         self.mass = wp.array(rho0 * vol, dtype=wp.float64, device=d)
         self.vol = wp.array(vol, dtype=wp.float64, device=d)
         self.vol0 = wp.array(vol, dtype=wp.float64, device=d)
@@ -196,6 +210,43 @@ class MPMSolver:
             self.shape_l,
         )
 
+    def set_gas_state(self, rho: np.ndarray, p: np.ndarray, v: np.ndarray | None = None) -> None:
+        """Start the particles as fully burnt products in a given state (JWL only; e.g. a shock tube).
+
+        rho [n] kg/m^3 and p [n] Pa per particle (v [n,2] m/s optional).  Keeps the volumes; sets
+        m_p = rho V_p, the reference volume V_p0 = m_p / rho0 (so that V = rho0/rho and the JWL sound
+        speed are those of the given density), ie = E V_p0 with p = a(V) + (omega/V) E, F = 1, sigma = -p I
+        and c from the JWL.  ``energies()['initial_internal']`` becomes this state's internal energy.
+        """
+        if not self.is_jwl:
+            raise TypeError("set_gas_state needs a JWL material")
+        from blastfrac.materials.jwl import V_FLOOR, jwl_a_np
+
+        P = self.material
+        vol = self.vol.numpy().copy()
+        rho = np.broadcast_to(np.asarray(rho, F64), vol.shape).copy()
+        p = np.broadcast_to(np.asarray(p, F64), vol.shape).copy()
+        mass = rho * vol
+        vol0 = mass / P.rho0
+        Vc = np.maximum(vol / vol0, V_FLOOR)
+        E = (p - jwl_a_np(Vc, P.A, P.B, P.R1, P.R2, P.omega)) * Vc / P.omega
+        ie = E * vol0
+        c2 = jwl_sound_speed_sq_np(Vc, E, p, P.rho0, P.A, P.B, P.R1, P.R2, P.omega)
+        self.mass.assign(mass)
+        self.vol0.assign(vol0)
+        self.vol_prev.assign(vol)
+        self.rho.assign(rho)
+        self.ie.assign(ie)
+        self.p.assign(p)
+        self.q.zero_()
+        self.burn.assign(np.ones(len(vol)))
+        self.stress.assign(-p[:, None, None] * np.eye(2)[None])
+        self.cs.assign(np.sqrt(c2))
+        self.b_aff.zero_()
+        if v is not None:
+            self.v.assign(np.asarray(v, F64).reshape(-1, 2))
+        self._chem0 = ie.copy()
+
     def _check_in_grid(self, x: np.ndarray) -> None:
         s = self.spec
         ok = np.ones(len(x), dtype=bool)
@@ -219,7 +270,7 @@ class MPMSolver:
         wp.launch(
             p2g,
             dim=self.n,
-            inputs=[self.x, self.v, self.mass, self.vol, self.stress, self.f_ext_p, self.f_ext_moment, self.active,
+            inputs=[self.x, self.v, self.b_aff, self.mass, self.vol, self.stress, self.f_ext_p, self.f_ext_moment, self.active,
                     *self._geo_f()],
             outputs=[g.mass, g.mom, g.force],
             device=self.device,
@@ -253,17 +304,23 @@ class MPMSolver:
                       outputs=[g.vel, g.dvel, g.mom], device=self.device)
 
     def to_particles(self, dt: float) -> None:
-        """G2P (FLIP/PIC), MUSL remap, velocity gradient, volume and position update."""
+        """G2P (FLIP/PIC or APIC), MUSL remap (with the affine term), velocity gradient, volume and position update."""
         g, geo, d = self.grid, self._geo_f(), self.device
-        wp.launch(
-            g2p_velocity,
-            dim=self.n,
-            inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip)],
-            outputs=[self.v, self.v_pic],
-            device=d,
-        )
+        if self.apic:
+            v_max = self.opts.v_max if self.is_jwl else float("inf")
+            wp.launch(g2p_velocity_apic, dim=self.n, inputs=[self.x, self.active, g.vel, *geo, self.vol, self.vol0, F64(v_max)],
+                      outputs=[self.v, self.v_pic, self.b_aff], device=d)
+        else:
+            wp.launch(
+                g2p_velocity,
+                dim=self.n,
+                inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip)],
+                outputs=[self.v, self.v_pic],
+                device=d,
+            )
         g.mom.zero_()
-        wp.launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.mass, self.active, *geo], outputs=[g.mom], device=d)
+        wp.launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo],
+                  outputs=[g.mom], device=d)
         self._fold_walls(0)
         wp.launch(
             velocity_from_momentum,
@@ -348,8 +405,29 @@ class MPMSolver:
         a = self._act()
         return (self.mass.numpy()[a, None] * self.v.numpy()[a]).sum(axis=0)
 
+    def affine_inertia(self) -> np.ndarray:
+        """D_p = Σ N_I (x_I − x_p) ⊗ (x_I − x_p) [m^2] of every particle, shape [n, 2, 2] (h²/4 I for B-splines)."""
+        return affine_inertia_np(self.x.numpy(), self.spec, self.opts.shape, self.shape_l)
+
+    def affine_velocity(self) -> np.ndarray:
+        """APIC affine velocity C_p = B_p D_p⁻¹ [1/s] of every particle, shape [n, 2, 2] (0 with FLIP/PIC)."""
+        return affine_from_moments_np(self.b_aff.numpy(), self.affine_inertia())
+
+    def total_angular_momentum(self, origin=(0.0, 0.0)) -> float:
+        """Angular momentum of the active particles about ``origin`` [kg m^2/s per m]: Σ m (x − o) × v plus,
+        with APIC, the affine spin Σ m [B_yx − B_xy] (:mod:`blastfrac.mpm.apic`)."""
+        a = self._act()
+        m, x, v = self.mass.numpy()[a], self.x.numpy()[a] - np.asarray(origin, F64), self.v.numpy()[a]
+        out = float((m * (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0])).sum())
+        if self.apic:
+            out += float(affine_angular_momentum_np(m, self.b_aff.numpy()[a]).sum())
+        return out
+
     def energies(self) -> dict[str, float]:
         """Energies of the active particles [J/m].
+
+        ``kinetic`` is Σ ½ m v², plus with APIC the affine part Σ ½ m tr(B D⁻¹ Bᵀ) (also given alone as
+        ``kinetic_affine``; 0 with FLIP/PIC), the kinetic energy of the particles' linear velocity fields.
 
         JWL: internal (sum ie), kinetic, total (internal + kinetic), released_chemical
         (sum F E0 V0: chemical energy liberated by the burn), initial_internal (sum E0 V0)
@@ -362,16 +440,23 @@ class MPMSolver:
         a = self._act()
         v = self.v.numpy()[a]
         ke = 0.5 * float((self.mass.numpy()[a] * (v * v).sum(axis=1)).sum())
+        ke_aff = 0.0
+        if self.apic:
+            B, D = self.b_aff.numpy()[a], self.affine_inertia()[a]
+            ke_aff = float(affine_kinetic_energy_np(self.mass.numpy()[a], B, D).sum())
+            ke += ke_aff
         if not self.is_jwl:
             m = self.material
             w = strain_energy_density_np(self.stress.numpy()[a], m.E, m.nu)
             se = float(self.ie.numpy()[a].sum())
-            return {"kinetic": ke, "strain": se, "total": ke + se, "strain_closed_form": float((w * self.vol.numpy()[a]).sum())}
+            return {"kinetic": ke, "kinetic_affine": ke_aff, "strain": se, "total": ke + se,
+                    "strain_closed_form": float((w * self.vol.numpy()[a]).sum())}
         ie = float(self.ie.numpy()[a].sum())
         chem0 = self._chem0[a]
         return {
             "internal": ie,
             "kinetic": ke,
+            "kinetic_affine": ke_aff,
             "total": ie + ke,
             "released_chemical": float((self.burn.numpy()[a] * chem0).sum()),
             "initial_internal": float(chem0.sum()),
