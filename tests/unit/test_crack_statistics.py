@@ -218,3 +218,25 @@ def test_crack_figures_show_detached_cracks(model, tmp_path):
     assert seg_detached.sum() == detached.sum()
     fracture_pattern(tmp_path / "pattern.png", X, seg, cmode, circles=[((0.0, 0.0), R_B)], detached=seg_detached)
     assert (tmp_path / "profile.png").stat().st_size > 0 and (tmp_path / "pattern.png").stat().st_size > 0
+
+
+def test_crack_extent_is_the_radius_enclosing_a_fraction_of_the_cracked_length():
+    """Cracked segments of known lengths at known radii: the extent radii follow from the cumulative length."""
+    from blastfrac.analysis.cracks import crack_extent
+
+    r = np.arange(1.0, 11.0) * 0.01                       # ten segments at 1 … 10 cm from the centre
+    ang = np.linspace(0, 2 * np.pi, 10, endpoint=False)
+    mid = np.stack([r * np.cos(ang), r * np.sin(ang)], 1)
+    L = np.ones(10) * 1e-3
+    cracked = np.ones(10, bool)
+    e = crack_extent(mid, L, cracked, np.zeros(2))
+    assert e["crack_length_total"] == pytest.approx(0.01)
+    assert e["crack_extent_r50"] == pytest.approx(0.05) and e["crack_extent_r90"] == pytest.approx(0.09)
+    # make the outermost segment 10× longer: it then holds more than half of the length, so r50 jumps to it ...
+    L2 = L.copy()
+    L2[-1] = 10e-3
+    e2 = crack_extent(mid, L2, cracked, np.zeros(2))
+    assert e2["crack_extent_r50"] == pytest.approx(0.10) and e2["crack_extent_r80"] == pytest.approx(0.10)
+    # ... and uncracked interfaces do not count
+    cracked[-1] = False
+    assert crack_extent(mid, L2, cracked, np.zeros(2))["crack_extent_r90"] == pytest.approx(0.09)
