@@ -70,6 +70,23 @@ def integrate_blocks(
     a = m * (wp.float64(1.0) - wp.float64(0.75) * theta)
     b = m * wp.float64(0.25) * theta
     s_old = v[n0] + v[n0 + 1] + v[n0 + 2]
+    if alpha == wp.float64(0.0) and node_bc[n0] < 0 and node_bc[n0 + 1] < 0 and node_bc[n0 + 2] < 0:
+        # a free block (most of them): H_k = I/a, so s = Σ r_k/(a + 3b) and v_k = (r_k − b s)/a
+        q0 = v[n0] * a + s_old * b + f[n0] * dt
+        q1 = v[n0 + 1] * a + s_old * b + f[n0 + 1] * dt
+        q2 = v[n0 + 2] * a + s_old * b + f[n0 + 2] * dt
+        sf = (q0 + q1 + q2) * (wp.float64(1.0) / (a + wp.float64(3.0) * b))
+        ia = wp.float64(1.0) / a
+        u0 = (q0 - sf * b) * ia
+        u1 = (q1 - sf * b) * ia
+        u2 = (q2 - sf * b) * ia
+        v[n0] = u0
+        v[n0 + 1] = u1
+        v[n0 + 2] = u2
+        x[n0] = x[n0] + u0 * dt
+        x[n0 + 1] = x[n0 + 1] + u1 * dt
+        x[n0 + 2] = x[n0 + 2] + u2 * dt
+        return
     H0 = eye
     H1 = eye
     H2 = eye
