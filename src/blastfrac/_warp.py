@@ -8,11 +8,15 @@ from __future__ import annotations
 
 import functools
 import os
+import re
 import sys
 
 import warp as wp
 
 F64 = wp.float64
+
+#: the device names a scenario or ``--device`` may give: cpu, cuda, cuda:N (N >= 0)
+DEVICE_PATTERN = re.compile(r"^(cpu|cuda(?::([0-9]+))?)$")
 
 
 @functools.cache
@@ -41,8 +45,15 @@ def resolve_device(name: str | None) -> str:
     init_warp()
     if name is None or name == "cpu":
         return "cpu"
-    if name.startswith("cuda"):
-        if not wp.is_cuda_available():
-            raise ValueError(f"device '{name}' requested but no CUDA device is available; use device='cpu'")
-        return "cuda:0" if name == "cuda" else name
-    raise ValueError(f"unknown device '{name}': expected 'cpu', 'cuda' or 'cuda:N'")
+    m = DEVICE_PATTERN.match(name)
+    if m is None:
+        raise ValueError(f"unknown device '{name}': expected 'cpu', 'cuda' or 'cuda:N' with N >= 0")
+    if not wp.is_cuda_available():
+        raise ValueError(f"device '{name}' requested but no CUDA device is available; use device='cpu'")
+    if m.group(2) is not None:
+        count = wp.get_cuda_device_count()
+        if int(m.group(2)) >= count:
+            raise ValueError(f"device '{name}' requested but this machine has {count} CUDA device(s) "
+                             f"(cuda:0..cuda:{count - 1})")
+        return f"cuda:{int(m.group(2))}"
+    return "cuda:0"

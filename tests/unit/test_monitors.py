@@ -246,4 +246,4 @@ def test_negative_radius_is_refused():
                  monitors=[{"name": "m", "position": [0.0, 0.0], "radius": -1e-3}])
     msg = str(e.value)
     print(f"negative radius: {msg}")
-    assert "monitors.0.radius" in msg and "greater than or equal to 0" in msg
+    assert "monitors[0].radius" in msg and "greater than or equal to 0" in msg

@@ -34,8 +34,12 @@ def _load(name: str):
 
 def run(args) -> int:
     from .._warp import resolve_device
+    from ..scenario import ScenarioError
 
-    device = resolve_device(args.device)
+    try:
+        device = resolve_device(args.device)
+    except ValueError as e:
+        raise ScenarioError(f"--device: {e}") from None
     if args.only in (None, "cdem"):
         cdem = _load("bench_cdem")
         sizes = (5_000, 20_000) if args.quick else (50_000, 200_000, 800_000)

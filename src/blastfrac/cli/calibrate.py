@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from .common import add_scenario_args, load
+from .common import add_scenario_args, check_output_dir, load
 
 
 def add_parser(sub) -> None:
@@ -106,6 +106,7 @@ def run(args) -> int:
     sc = load(args)
     us, bs = _settings(args)
     out = Path(args.out) if args.out else Path(sc.output.directory) / "calibration"
+    check_output_dir(out, "--out" if args.out else "output.directory")
     out.mkdir(parents=True, exist_ok=True)
     hu = args.ucs_mesh_size or args.mesh_size
     hb = args.brazilian_mesh_size or args.mesh_size

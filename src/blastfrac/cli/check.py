@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import math
 
-from .common import add_scenario_args, load
+from .common import add_force_arg, add_scenario_args, check_output_dir, load, resolve_device
 
 
 def add_parser(sub) -> None:
     p = sub.add_parser("check", help="validate a scenario and print what would run")
     add_scenario_args(p)
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
@@ -26,8 +27,12 @@ def model_bytes(model) -> int:
 def run(args) -> int:
     from ..scenario import ScenarioError
     from ..model.builder import ModelBuilder
+    from ..scenario.sizes import check_sizes
 
     sc = load(args)
+    check_output_dir(sc.output.directory, "output.directory")
+    resolve_device(sc, args)
+    est = check_sizes(sc, force=args.force)
     try:
         b = ModelBuilder(sc)
     except ValueError as e:
@@ -45,6 +50,7 @@ def run(args) -> int:
     rows = [
         ("title", sc.title or "-"),
         ("device", sc.simulation.device),
+        *est.rows(),
         ("elements (blocks)", f"{m.element_count}"),
         ("nodes", f"{m.node_count}"),
         ("springs (node pairs)", f"{m.spring_count} on {m.interface_count} interfaces"),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from .common import add_scenario_args, load
+from .common import add_force_arg, add_scenario_args, check_output_dir, load, resolve_device
 
 
 def add_parser(sub) -> None:
@@ -13,18 +13,25 @@ def add_parser(sub) -> None:
     p.add_argument("--out", default=None, help="output directory (default: output.directory of the scenario)")
     p.add_argument("--max-steps", type=int, default=None, help="stop after N steps of the dynamic stage")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    add_force_arg(p)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..scenario import ScenarioError
+    from ..scenario.sizes import check_sizes
     from ..simulation import Simulation, SimulationError
 
     sc = load(args)
     if args.out:
         sc.output.directory = args.out
+    check_output_dir(sc.output.directory, "--out" if args.out else "output.directory")
     if args.max_steps is not None and args.max_steps <= 0:
         raise ScenarioError("--max-steps must be a positive integer")
+    resolve_device(sc, args)
+    est = check_sizes(sc, force=args.force)
+    if est.elements is not None and est.elements > 500_000:
+        print(f"meshing about {est.elements:,} elements ({est.detail})", file=sys.stderr)
     try:
         sim = Simulation(sc, max_steps=args.max_steps)
     except ValueError as e:

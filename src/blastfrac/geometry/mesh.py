@@ -70,7 +70,10 @@ def generate_mesh(geom: GeometryConfig, seed: int = 0) -> TriMesh:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.model.add("blastfrac")
-        return _mesh_with_gmsh(gmsh, geom, seed)
+        try:
+            return _mesh_with_gmsh(gmsh, geom, seed)
+        except Exception as e:  # gmsh reports a geometry it cannot mesh as a bare Exception
+            raise ValueError(f"geometry: gmsh could not mesh this geometry ({e})") from None
     finally:
         gmsh.model.remove()
         if initialised_here:
@@ -183,11 +186,17 @@ def read_msh(path: str) -> TriMesh:
     """
     import meshio
 
-    m = meshio.read(path)
+    import meshio.gmsh
+
+    try:
+        # the format's reader itself: meshio.read() prints and calls sys.exit(1) on a file it cannot read
+        m = meshio.gmsh.read(str(path))
+    except Exception as e:  # meshio raises several kinds (ReadError, KeyError, ValueError...) on a bad file
+        raise ValueError(f"geometry.mesh_file: cannot read {path} as a gmsh .msh mesh ({type(e).__name__}: {e})") from None
     tri = np.concatenate([c.data for c in m.cells if c.type == "triangle"]) if any(
         c.type == "triangle" for c in m.cells) else None
     if tri is None:
-        raise ValueError(f"{path}: no triangle cells")
+        raise ValueError(f"geometry.mesh_file: {path} has no triangle cells")
     names = {int(v[0]): k for k, v in m.field_data.items() if len(v) > 1 and int(v[1]) == 1}
     phys = m.cell_data.get("gmsh:physical")
     bedges, btags = [], []

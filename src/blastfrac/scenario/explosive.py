@@ -14,15 +14,19 @@ custom JWL set (``constants``), never both.  Example::
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from . import _geometry as geo
 
 Point = tuple[float, float]
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    # allow_inf_nan=False: every float, also inside tuples, lists and nested models, must be finite
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
 
 class JWLConstants(_Model):
@@ -45,12 +49,52 @@ class CircleCharge(_Model):
     center: Point = Field(description="centre (x, y) [m]")
     radius: float = Field(gt=0, description="radius [m]")
 
+    @property
+    def area(self) -> float:
+        return math.pi * self.radius**2
+
+    @property
+    def bbox(self) -> tuple[Point, Point]:
+        (x, y), r = self.center, self.radius
+        return (x - r, y - r), (x + r, y + r)
+
+    def contains(self, p: Point, tol: float = 1e-9) -> bool:
+        """p inside or on the circle (within tol·radius)."""
+        return math.dist(p, self.center) <= self.radius * (1 + tol)
+
 
 class PolygonCharge(_Model):
     """A polygonal charge; vertices in order (either orientation)."""
 
     kind: Literal["polygon"] = Field(description="charge shape tag")
     vertices: list[Point] = Field(min_length=3, description="vertices (x, y) [m], at least 3")
+
+    @model_validator(mode="after")
+    def _simple(self) -> PolygonCharge:
+        v = self.vertices
+        rep = geo.repeated_vertex(v)
+        if rep is not None:
+            raise ValueError(f"vertices[{rep[1]}]: {v[rep[1]]} repeats vertices[{rep[0]}]; every vertex must be distinct")
+        if geo.polygon_area(v) == 0:
+            raise ValueError("vertices: the polygon encloses no area")
+        cross = geo.polygon_self_intersection(v)
+        if cross is not None:
+            raise ValueError(f"vertices: sides {cross[0]} and {cross[1]} meet; the polygon must not intersect itself")
+        return self
+
+    @property
+    def area(self) -> float:
+        return abs(geo.polygon_area(self.vertices))
+
+    @property
+    def bbox(self) -> tuple[Point, Point]:
+        xs, ys = [p[0] for p in self.vertices], [p[1] for p in self.vertices]
+        return (min(xs), min(ys)), (max(xs), max(ys))
+
+    def contains(self, p: Point, tol: float = 1e-9) -> bool:
+        """p inside or on the polygon (within tol of its size)."""
+        (x0, y0), (x1, y1) = self.bbox
+        return geo.point_in_polygon(p, self.vertices) or geo.polygon_dist(p, self.vertices) <= tol * max(x1 - x0, y1 - y0)
 
 
 Charge = Annotated[CircleCharge | PolygonCharge, Field(discriminator="kind")]
@@ -151,7 +195,32 @@ class ExplosiveConfig(_Model):
             try:
                 get_explosive(self.name)
             except KeyError as exc:
-                raise ValueError(str(exc.args[0])) from None
+                raise ValueError("name: " + str(exc.args[0])) from None
+        for j, ch in enumerate(self.charges):
+            for i in range(j):
+                if ch == self.charges[i]:
+                    raise ValueError(f"charges[{j}]: repeats charges[{i}]")
+        spacing = self.grid.cell_size / self.grid.points_per_cell
+        for i, ch in enumerate(self.charges):
+            if ch.area < spacing**2:
+                raise ValueError(f"grid.cell_size: the particle spacing cell_size/points_per_cell = {spacing:.4g} m leaves "
+                                 f"charges[{i}] (area {ch.area:.4g} m²) less than one material point; use a finer grid")
+        if self.grid.bounds is not None:
+            (x0, y0), (x1, y1) = self.grid.bounds
+            tol = 1e-9 * max(x1 - x0, y1 - y0)
+            for i, ch in enumerate(self.charges):
+                (a0, b0), (a1, b1) = ch.bbox
+                if a0 < x0 - tol or b0 < y0 - tol or a1 > x1 + tol or b1 > y1 + tol:
+                    raise ValueError(f"grid.bounds: (({x0:.6g}, {y0:.6g}), ({x1:.6g}, {y1:.6g})) does not cover "
+                                     f"charges[{i}] (box ({a0:.6g}, {b0:.6g})–({a1:.6g}, {b1:.6g})); the grid must "
+                                     "cover every charge")
+        for k, dp in enumerate(self.detonation_points):
+            if not any(ch.contains(dp.position) for ch in self.charges):
+                raise ValueError(f"detonation_points[{k}]: position ({dp.position[0]:.6g}, {dp.position[1]:.6g}) is "
+                                 "not inside any charge")
+            for i in range(k):
+                if dp == self.detonation_points[i]:
+                    raise ValueError(f"detonation_points[{k}]: repeats detonation_points[{i}]")
         return self
 
     def jwl(self):

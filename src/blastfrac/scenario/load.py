@@ -42,10 +42,14 @@ def apply_overrides(data: dict, overrides: list[str]) -> dict:
             nxt = path[i + 1]
             if isinstance(node, list):
                 node = node[_index(part, text, len(node))]
-                continue
-            if part not in node:
-                node[part] = [] if nxt.isdigit() else {}
-            node = node[part]
+            else:
+                if part not in node:
+                    node[part] = [] if nxt.isdigit() else {}
+                node = node[part]
+            if not isinstance(node, (dict, list)):
+                where = ".".join(path[: i + 1])
+                raise ScenarioError(f"--set {text!r}: {where} is a value ({node!r}), not a section or a list; "
+                                    f"'{'.'.join(path[i + 1:])}' cannot be set inside it")
         last = path[-1]
         if isinstance(node, list):
             node[_index(last, text, len(node))] = value

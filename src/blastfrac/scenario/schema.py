@@ -17,20 +17,22 @@ from typing import Annotated, Literal, Union
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from . import _geometry as geo
 from .explosive import ExplosiveConfig
 
 Point = tuple[float, float]
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", validate_assignment=True)
+    # allow_inf_nan=False: every float, also inside tuples, lists and nested models, must be finite
+    model_config = ConfigDict(extra="forbid", validate_assignment=True, allow_inf_nan=False)
 
 
 # --------------------------------------------------------------------------- simulation
 class SimulationConfig(_Strict):
     """Clock, time step and compute device."""
 
-    end_time: float = Field(1e-4, gt=0, description="Simulated end time of the dynamic stage [s].")
+    end_time: float = Field(1e-4, gt=0, le=1.0, description="Simulated end time of the dynamic stage [s], at most 1 s.")
     dt_safety: float = Field(
         0.8, gt=0, le=1.0, description="Safety factor applied to the Gershgorin stable time step (0, 1]."
     )
@@ -38,7 +40,7 @@ class SimulationConfig(_Strict):
     damping: float = Field(
         0.0, ge=0, lt=1, description="Cundall local damping factor of the dynamic stage [-]; 0 for blasts."
     )
-    seed: int = Field(0, ge=0, description="Seed for mesh generation and any random field.")
+    seed: int = Field(0, ge=0, le=2**31 - 1, description="Seed of gmsh's random factor and of any random field. The gmsh Delaunay mesh does not change with it (measured: seeds 0, 1, 2 give identical meshes); for another mesh realisation change a mesh size by about 1 % (examples/confined_blast/mesh_study.md).")
     max_steps: int | None = Field(None, gt=0, description="Stop after this many steps even before end_time.")
     progress: bool = Field(True, description="Show a progress bar on the terminal.")
 
@@ -71,6 +73,8 @@ class OutputConfig(_Strict):
             raise ValueError("snapshot times must be >= 0 s")
         if len(v) > 12:
             raise ValueError("at most 12 snapshot times")
+        if len(set(v)) != len(v):
+            raise ValueError(f"snapshot times must be distinct (got {v})")
         return sorted(v)
 
 
@@ -78,8 +82,8 @@ class OutputConfig(_Strict):
 class RockConfig(_Strict):
     """Rock: elastic blocks (CST) and the breakable interface springs between them."""
 
-    density: float = Field(2600.0, gt=0, description="Mass density [kg/m³].")
-    youngs_modulus: float = Field(50e9, gt=0, description="Young's modulus of the blocks [Pa].")
+    density: float = Field(2600.0, gt=0, le=1e5, description="Mass density [kg/m³], at most 1e5.")
+    youngs_modulus: float = Field(50e9, gt=0, le=1e13, description="Young's modulus of the blocks [Pa], at most 1e13.")
     poisson_ratio: float = Field(0.2, ge=0, lt=0.5, description="Poisson's ratio of the blocks [-], in [0, 0.5).")
     stiffness_mode: Literal["penalty", "per_area"] = Field(
         "penalty",
@@ -194,6 +198,20 @@ class RectangleDomain(_Strict):
         )
 
     @property
+    def area(self) -> float:
+        return self.width * self.height
+
+    @property
+    def bbox(self) -> tuple[Point, Point]:
+        cx, cy, w2, h2 = self.center[0], self.center[1], self.width / 2, self.height / 2
+        return (cx - w2, cy - h2), (cx + w2, cy + h2)
+
+    @property
+    def polygon(self) -> list[Point]:
+        (x0, y0), (x1, y1) = self.bbox
+        return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+
+    @property
     def sides(self) -> tuple[str, ...]:
         return ("bottom", "right", "top", "left")
 
@@ -207,6 +225,15 @@ class DiscDomain(_Strict):
         return math.dist(p, self.center) <= self.radius - margin
 
     @property
+    def area(self) -> float:
+        return math.pi * self.radius**2
+
+    @property
+    def bbox(self) -> tuple[Point, Point]:
+        (cx, cy), r = self.center, self.radius
+        return (cx - r, cy - r), (cx + r, cy + r)
+
+    @property
     def sides(self) -> tuple[str, ...]:
         return ("outer",)
 
@@ -218,10 +245,29 @@ class PolygonDomain(_Strict):
     @model_validator(mode="after")
     def _ccw(self) -> "PolygonDomain":
         v = self.vertices
+        rep = geo.repeated_vertex(v)
+        if rep is not None:
+            raise ValueError(f"vertices[{rep[1]}]: {v[rep[1]]} repeats vertices[{rep[0]}]; every vertex must be distinct")
         area2 = sum(v[i][0] * v[(i + 1) % len(v)][1] - v[(i + 1) % len(v)][0] * v[i][1] for i in range(len(v)))
         if area2 <= 0:
             raise ValueError("polygon vertices must be counter-clockwise and enclose a positive area")
+        cross = geo.polygon_self_intersection(v)
+        if cross is not None:
+            raise ValueError(f"vertices: sides {cross[0]} and {cross[1]} meet; the polygon must not intersect itself")
         return self
+
+    @property
+    def area(self) -> float:
+        return geo.polygon_area(self.vertices)
+
+    @property
+    def bbox(self) -> tuple[Point, Point]:
+        xs, ys = [p[0] for p in self.vertices], [p[1] for p in self.vertices]
+        return (min(xs), min(ys)), (max(xs), max(ys))
+
+    @property
+    def polygon(self) -> list[Point]:
+        return list(self.vertices)
 
     def contains(self, p: Point, margin: float = 0.0) -> bool:
         v, inside = self.vertices, False
@@ -270,20 +316,30 @@ class GeometryConfig(_Strict):
         description="gmsh 2D algorithm; plain Delaunay gives a less regular mesh, so cracks are less biased to lattice directions.",
     )
 
+    @field_validator("mesh_file")
+    @classmethod
+    def _msh_extension(cls, v: str | None) -> str | None:
+        if v is not None and not v.lower().endswith(".msh"):
+            suffix = v.rsplit(".", 1)[-1] if "." in v.rsplit("/", 1)[-1] else ""
+            raise ValueError(f"{v!r}: unknown mesh file type {'.' + suffix if suffix else '(no extension)'}; "
+                             "expected a gmsh .msh file")
+        return v
+
     @model_validator(mode="after")
     def _holes_inside(self) -> "GeometryConfig":
         for i, b in enumerate(self.boreholes):
             if not self.domain.contains(b.center, margin=b.radius):
                 raise ValueError(
-                    f"boreholes[{i}] (centre {b.center}, radius {b.radius} m) is not fully inside the domain"
+                    f"boreholes[{i}]: centre {b.center}, radius {b.radius} m: not fully inside the domain"
                 )
         for i in range(len(self.boreholes)):
             for j in range(i + 1, len(self.boreholes)):
                 bi, bj = self.boreholes[i], self.boreholes[j]
                 if math.dist(bi.center, bj.center) <= bi.radius + bj.radius:
-                    raise ValueError(f"boreholes[{i}] and boreholes[{j}] overlap")
+                    raise ValueError(f"boreholes[{j}]: overlaps boreholes[{i}] (centres {bi.center} and {bj.center}, "
+                                     f"radii {bi.radius} and {bj.radius} m); boreholes must be apart")
         if self.mesh_size_near is not None and self.mesh_size_near > self.mesh_size:
-            raise ValueError("mesh_size_near must not exceed mesh_size")
+            raise ValueError(f"mesh_size_near: must not exceed mesh_size ({self.mesh_size_near} > {self.mesh_size} m)")
         return self
 
 
@@ -302,7 +358,15 @@ class ExponentialPulse(_Strict):
     type: Literal["exponential"] = "exponential"
     peak: float = Field(gt=0, description="Peak pressure [Pa].")
     rise_time: float = Field(gt=0, description="Time to peak [s].")
-    decay_time: float = Field(gt=0, description="e-folding decay time after the peak [s] (must exceed rise_time/2).")
+    decay_time: float = Field(gt=0, description="e-folding decay time after the peak [s] (must exceed rise_time: "
+                              "p0·(exp(-a t) - exp(-b t)) peaks before 1/a).")
+
+    @model_validator(mode="after")
+    def _decay_after_rise(self) -> "ExponentialPulse":
+        if not self.decay_time > self.rise_time:
+            raise ValueError(f"decay_time: must exceed rise_time ({self.decay_time} <= {self.rise_time} s); "
+                             "p0·(exp(-t/decay_time) - exp(-b t)) cannot peak later than decay_time")
+        return self
 
     def __call__(self, t: float) -> float:
         if t <= 0:
@@ -447,6 +511,14 @@ class Monitor(_Strict):
         "the point (nearest one if outside); 0 = that single element, nodes by barycentric weights.",
     )
 
+    @field_validator("quantities")
+    @classmethod
+    def _distinct(cls, v: list[str]) -> list[str]:
+        for j, q in enumerate(v):
+            if q in v[:j]:
+                raise ValueError(f"'{q}' is listed twice; each quantity once")
+        return v
+
 
 class AnnulusZone(_Strict):
     type: Literal["annulus"] = "annulus"
@@ -561,19 +633,107 @@ class Scenario(_Strict):
         for name in self.boundaries:
             if name not in sides:
                 raise ValueError(f"boundaries.{name}: unknown side; this domain has {sorted(sides)}")
+        loaded: dict[int, int] = {}
         for i, bp in enumerate(self.borehole_pressure):
             if bp.borehole >= len(self.geometry.boreholes):
                 raise ValueError(
                     f"borehole_pressure[{i}].borehole = {bp.borehole} but only {len(self.geometry.boreholes)} boreholes exist"
                 )
-        names = [m.name for m in self.monitors]
-        if len(set(names)) != len(names):
-            raise ValueError("monitor names must be unique")
+            if bp.borehole in loaded:
+                raise ValueError(f"borehole_pressure[{i}]: borehole {bp.borehole} already has a pulse "
+                                 f"(borehole_pressure[{loaded[bp.borehole]}]); give one pulse per borehole")
+            if self.boundary(f"hole{bp.borehole}").type == "pressure":
+                raise ValueError(f"borehole_pressure[{i}]: borehole {bp.borehole} already has a pulse "
+                                 f"(boundaries.hole{bp.borehole}); give one pulse per borehole")
+            loaded[bp.borehole] = i
+        _unique_names(self.monitors, "monitors")
+        _unique_names(self.zones, "zones")
+        for i, m in enumerate(self.monitors):
+            if "gas_pressure" in m.quantities and self.explosive is None:
+                raise ValueError(f"monitors[{i}].quantities: 'gas_pressure' needs an [explosive] section (there is no gas)")
         if self.geometry.mesh_file is None:
             for i, m in enumerate(self.monitors):
                 if not self.geometry.domain.contains(m.position):
                     raise ValueError(f"monitors[{i}] ({m.name}) at {m.position} is outside the domain")
+            if self.explosive is not None:
+                _explosive_fits_rock(self.explosive, self.geometry)
         return self
 
     def boundary(self, side: str) -> BoundarySide:
         return self.boundaries.get(side, BoundarySide())
+
+
+def _unique_names(items, what: str) -> None:
+    first: dict[str, int] = {}
+    for j, it in enumerate(items):
+        if it.name in first:
+            raise ValueError(f"{what}[{j}].name: '{it.name}' is already used by {what}[{first[it.name]}]; names must be unique")
+        first[it.name] = j
+
+
+def _fmt(p) -> str:
+    return f"({p[0]:.6g}, {p[1]:.6g})"
+
+
+def _explosive_fits_rock(ex: ExplosiveConfig, geom: GeometryConfig) -> None:
+    """Each charge lies inside a borehole or wholly outside the rock domain; the default grid covers it.
+
+    Raises ValueError naming the first charge that breaks a rule (tolerance 1e-9 of the lengths involved).
+    """
+    d, holes = geom.domain, geom.boreholes
+    for i, ch in enumerate(ex.charges):
+        key = f"explosive.charges[{i}]"
+        if ch.kind == "circle":
+            c, r, pts = ch.center, ch.radius, None
+            what = f"circle centre {_fmt(c)}, radius {r:.6g} m"
+        else:
+            pts = list(ch.vertices)
+            c, r = geo.polygon_centroid(pts), None
+            what = f"polygon with centroid {_fmt(c)}"
+        host = next((j for j, b in enumerate(holes) if math.dist(c, b.center) < b.radius), None)
+        if host is not None:
+            b = holes[host]
+            tol = 1e-9 * b.radius
+            if pts is None:
+                if r > b.radius + tol:
+                    raise ValueError(f"{key}: radius {r:.6g} m is larger than its borehole geometry.boreholes[{host}] "
+                                     f"(radius {b.radius:.6g} m); a charge must fit inside its hole")
+                inside = math.dist(c, b.center) + r <= b.radius + tol
+            else:
+                inside = all(math.dist(p, b.center) <= b.radius + tol for p in pts)
+            if not inside:
+                raise ValueError(f"{key}: {what} extends past the wall of geometry.boreholes[{host}] (centre "
+                                 f"{_fmt(b.center)}, radius {b.radius:.6g} m) into the rock; a charge must lie "
+                                 "inside its borehole or outside the rock")
+        else:
+            if d.contains(c):
+                raise ValueError(f"{key}: {what} lies in the rock (inside the domain and in no borehole); a charge "
+                                 "must lie inside a borehole or outside the rock")
+            if _overlaps_domain(d, c, r, pts):
+                raise ValueError(f"{key}: {what} overlaps the rock across the domain boundary; a charge must lie "
+                                 "inside a borehole or outside the rock")
+    if ex.grid.bounds is None and ex.grid.margin is None:
+        # the run's default grid covers the rock's box (simulation.py)
+        (x0, y0), (x1, y1) = d.bbox
+        tol = 1e-9 * max(x1 - x0, y1 - y0)
+        for i, ch in enumerate(ex.charges):
+            (a0, b0), (a1, b1) = ch.bbox
+            if a0 < x0 - tol or b0 < y0 - tol or a1 > x1 + tol or b1 > y1 + tol:
+                raise ValueError(f"explosive.charges[{i}]: lies outside the rock's box {_fmt((x0, y0))}–{_fmt((x1, y1))} "
+                                 "that the default grid covers; give explosive.grid.bounds or explosive.grid.margin")
+
+
+def _overlaps_domain(d, c, r, pts) -> bool:
+    """True when a circle (c, r) or polygon pts whose centre c lies outside domain d shares area with it."""
+    if pts is None:
+        tol = 1e-9 * r
+        if isinstance(d, DiscDomain):
+            return math.dist(c, d.center) < d.radius + r - tol
+        return geo.polygon_dist(c, d.polygon) < r - tol
+    if isinstance(d, DiscDomain):
+        tol = 1e-9 * d.radius
+        if geo.point_in_polygon(d.center, pts) or any(math.dist(p, d.center) < d.radius - tol for p in pts):
+            return True
+        return geo.polygon_dist(d.center, pts) < d.radius - tol
+    (x0, y0), (x1, y1) = d.bbox
+    return geo.polygons_overlap(pts, d.polygon, 1e-9 * max(x1 - x0, y1 - y0))
