@@ -28,8 +28,10 @@ TENSILE, SHEAR = "#d62728", "#1f77b4"
 def read_csv(path: Path) -> dict[str, np.ndarray]:
     with open(path) as f:
         rows = list(csv.reader(f))
+    rows = [r for r in rows if r and not r[0].startswith("#")]
     head, data = rows[0], np.array(rows[1:], float)
-    return {k: data[:, i] for i, k in enumerate(head)}
+    # headers carry units, 'm50mm:sxx [Pa]': key the columns by the bare name
+    return {k.split(" [")[0].strip(): data[:, i] for i, k in enumerate(head)}
 
 
 def run_numbers(run: Path) -> dict:

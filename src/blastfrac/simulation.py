@@ -8,6 +8,7 @@ progress bar and a NaN guard. The in-situ stress stage, when asked for, runs fir
 from __future__ import annotations
 
 import math
+import sys
 import time as _time
 from pathlib import Path
 
@@ -21,14 +22,25 @@ from .analysis.fracture import FractureDegree
 from .analysis.monitors import MonitorSet
 from .cdem.solver import CDEMSolver
 from .io.paraview import GasSeries, ParaviewSeries, crack_segments
-from .io.tables import CsvHistory, write_summary
+from .io.tables import CsvHistory, monitor_unit, write_summary
 from .model.builder import ModelBuilder
 from .scenario.load import write_resolved
 from .scenario.schema import Scenario
 
 
+_BUDGET_MIN_STEPS = 50      # energy-budget samples before this step are not checked against output.budget_warning
+
+
 class SimulationError(RuntimeError):
-    """The run became unphysical (NaN, blow-up); the message says where and when."""
+    """The run became unphysical (NaN, blow-up); the message says where and when.
+
+    ``details`` (a dict, also written to summary.json → ``failure``) holds the step, time, the non-finite
+    energy terms and the first non-finite node / element / particle with its position.
+    """
+
+    def __init__(self, message: str, details: dict | None = None):
+        super().__init__(message)
+        self.details = details or {}
 
 
 class Simulation:
@@ -59,6 +71,9 @@ class Simulation:
         self.monitors = MonitorSet(scenario.monitors, X, self.model.host["node_mass"])
         self.insitu_report: dict | None = None
         self.initial_stored = 0.0
+        self.initial_dissipated = 0.0   # fracture energy of springs broken before the dynamic stage [J/m]
+        self.warnings: list[str] = []
+        self._budget_warned = False
 
     # ------------------------------------------------------------------ explosive and coupling
     def _build_explosive(self) -> None:
@@ -163,6 +178,7 @@ class Simulation:
         self.state.v.zero_()
         self.state.energy_acc.zero_()
         self.cdem.dt_prev = 0.0
+        self.initial_dissipated = self.cdem.rebase_spring_work(self.state)
         e = rock_energies(self.model, self.state)
         self.initial_stored = e["strain"] + e["springs"]
         counts = self.fracture.counts(mode)
@@ -199,14 +215,46 @@ class Simulation:
         self.snapshots: list[dict] = []
         series = ParaviewSeries(self.out_dir) if sc.output.paraview else None
         gas_series = GasSeries(self.out_dir) if sc.output.paraview and self.gas is not None else None
-        mon = CsvHistory(self.out_dir / "monitors.csv", self.monitors.columns)
-        frac = CsvHistory(self.out_dir / "fracture_degree.csv", list(self.fracture.sample(self.state.pair_mode.numpy())))
+        mon = CsvHistory(self.out_dir / "monitors.csv", self.monitors.columns, unit=monitor_unit)
+        frac = CsvHistory(self.out_dir / "fracture_degree.csv", list(self.fracture.sample(self.state.pair_mode.numpy())),
+                          unit="-")
         energy_cols = ["kinetic", "strain", "springs", "fracture", "friction", "viscous_absorbed", "damping",
                        "external_work"]
         if self.gas is not None:
             energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_energy"]
-        energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"])
+        energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"], unit="J/m")
         wall0 = _time.perf_counter()
+        try:
+            self._run_loop(show, end, frame_dt, sample_dt, snap_times, series, gas_series, mon, frac, energy)
+        except SimulationError as err:
+            self._write_failed(err, _time.perf_counter() - wall0, (mon, frac, energy))
+            raise
+        wall = _time.perf_counter() - wall0
+        for h in (mon, frac, energy):
+            h.flush()
+        summary = self.summary(wall)
+        write_summary(self.out_dir / "summary.json", summary)
+        if sc.output.figures:
+            self.write_figures(mon, frac, energy, cracks=summary["cracks"])
+        return summary
+
+    def _write_failed(self, err: SimulationError, wall: float, histories) -> None:
+        """After a blow-up: the CSV histories up to the failure and summary.json with ``status = 'failed'``."""
+        for h in histories:
+            h.flush()
+        try:
+            summary = self.summary(wall)
+        except Exception as e2:  # noqa: BLE001 - the state is broken; keep what can be said
+            summary = {"blastfrac_version": __version__, "title": self.scenario.title, "device": self.device,
+                       "steps": self.steps, "simulated_time": self.time, "time_step": self.dt,
+                       "summary_error": f"{type(e2).__name__}: {e2}"}
+        summary["status"] = "failed"
+        summary["error"] = str(err)
+        summary["failure"] = err.details
+        write_summary(self.out_dir / "summary.json", summary)
+
+    def _run_loop(self, show, end, frame_dt, sample_dt, snap_times, series, gas_series, mon, frac, energy) -> None:
+        sc = self.scenario
         with _progress(show) as bar:
             if sc.insitu.active:
                 self.relax_insitu(bar)
@@ -246,14 +294,6 @@ class Simulation:
                 gas_series.write(self.gas, self.time)
             if k_snap < len(snap_times) or not self.snapshots:
                 self._snapshot()
-        wall = _time.perf_counter() - wall0
-        for h in (mon, frac, energy):
-            h.flush()
-        summary = self.summary(wall)
-        write_summary(self.out_dir / "summary.json", summary)
-        if sc.output.figures:
-            self.write_figures(mon, frac, energy, cracks=summary["cracks"])
-        return summary
 
     def energies(self) -> dict[str, float]:
         """All energy terms of rock, gas and contact [J/m] (see analysis.energy)."""
@@ -274,9 +314,27 @@ class Simulation:
         mon.append(self.time, self.monitors.sample(x, self.model.host["node_X"], v, sig, gas_pressure=gp))
         frac.append(self.time, self.fracture.sample(st.pair_mode.numpy()).values())
         e = self.energies()
-        self._guard(e)
-        err, _ = budget_error(e, self.initial_stored)
+        err, rel = budget_error(e, self.initial_stored + self.initial_dissipated)
         energy.append(self.time, [*(e[k] for k in energy.columns[1:-1]), err])
+        self._guard(e)
+        self._check_budget(err, rel)
+
+    def _check_budget(self, err: float, rel: float, final: bool = False) -> None:
+        """Warn once (stderr and summary.json → warnings) when |budget_error_relative| > output.budget_warning.
+
+        Samples of the first ``_BUDGET_MIN_STEPS`` steps are not checked (the work sums lag the state by one
+        step, a large fraction of the tiny energies at the start); the final state always is.
+        """
+        limit = self.scenario.output.budget_warning
+        if self._budget_warned or not abs(rel) > limit or (self.steps < _BUDGET_MIN_STEPS and not final):
+            return
+        self._budget_warned = True
+        msg = (f"energy budget error {rel * 100:+.1f} % ({err:.4g} J/m) at step {self.steps} (t = {self.time:.4e} s) "
+               f"exceeds output.budget_warning = {limit * 100:g} %; the energy terms do not balance "
+               "(see docs/results.md, 'Energy budget'); check the time step (simulation.dt_safety) and the contact "
+               "settings before trusting the energies")
+        self.warnings.append(msg)
+        print(f"warning: {msg}", file=sys.stderr, flush=True)
 
     def _snapshot(self) -> None:
         x = self.state.x.numpy().copy()
@@ -288,17 +346,83 @@ class Simulation:
 
     def _guard(self, e: dict) -> None:
         if not all(math.isfinite(v) for v in e.values()):
-            raise SimulationError(
-                f"non-finite energy at step {self.steps} (t = {self.time:.4e} s); "
-                "reduce simulation.dt_safety or check the loads"
-            )
+            msg, details = self._diagnose_nonfinite(e)
+            raise SimulationError(msg, details)
+
+    def _diagnose_nonfinite(self, e: dict) -> tuple[str, dict]:
+        """Where the run blew up: the first non-finite rock node, element and gas particle, and a likely cause."""
+        st, X = self.state, self.model.host["node_X"]
+        bad_terms = [k for k, v in e.items() if not math.isfinite(v)]
+        details: dict = {"step": self.steps, "time": self.time, "time_step": self.dt,
+                         "stable_time_step": self.model.stable_dt, "non_finite_energy_terms": bad_terms}
+        where: list[str] = []
+        x, v, sig = st.x.numpy(), st.v.numpy(), st.sigma.numpy()
+        bad_n = np.flatnonzero(~(np.isfinite(x).all(1) & np.isfinite(v).all(1)))
+        if len(bad_n):
+            n = int(bad_n[0])
+            pos = [float(c) for c in X[n]]
+            details["node"] = {"index": n, "reference_position": pos, "count": int(len(bad_n))}
+            where.append(f"rock node {n} at (x, y) = ({pos[0]:.4g}, {pos[1]:.4g}) m ({len(bad_n)} nodes non-finite)")
+        bad_e = np.flatnonzero(~np.isfinite(sig).all(1))
+        if len(bad_e):
+            k = int(bad_e[0])
+            c = X[3 * k:3 * k + 3].mean(axis=0)       # elements own their 3 nodes (blocks: nodes 3k, 3k+1, 3k+2)
+            details["element"] = {"index": k, "reference_centroid": [float(c[0]), float(c[1])], "count": int(len(bad_e))}
+            where.append(f"element {k} centred at ({c[0]:.4g}, {c[1]:.4g}) m ({len(bad_e)} elements non-finite)")
+        if not len(bad_n) and len(v):
+            # the state is still finite but its energy sums overflowed: point at the fastest node
+            with np.errstate(over="ignore", invalid="ignore"):
+                speed = np.hypot(v[:, 0], v[:, 1])
+            n = int(np.nanargmax(np.where(np.isfinite(speed), speed, -1.0)))
+            pos = [float(c) for c in X[n]]
+            details["node"] = {"index": n, "reference_position": pos, "speed": float(speed[n]), "count": 0}
+            bad_n = np.array([n])
+            where.append(f"no non-finite value in the state yet (the energy sums overflowed); fastest rock node {n} "
+                         f"at (x, y) = ({pos[0]:.4g}, {pos[1]:.4g}) m, |v| = {speed[n]:.3g} m/s")
+        gas_bad = False
+        if self.gas is not None:
+            f = self.gas.particle_fields()
+            ok = np.isfinite(f["position"]).all(1) & np.isfinite(f["velocity"]).all(1) & np.isfinite(f["pressure"]) \
+                & np.isfinite(f["internal_energy"])
+            bad_p = np.flatnonzero(~ok)
+            if len(bad_p):
+                gas_bad = True
+                i = int(bad_p[0])
+                p = f["position"][i]
+                details["particle"] = {"index": i, "position": [float(c) for c in p], "count": int(len(bad_p))}
+                at = f"at ({p[0]:.4g}, {p[1]:.4g}) m" if np.isfinite(p).all() else "(position non-finite)"
+                where.append(f"gas particle {i} {at} ({len(bad_p)} particles non-finite)")
+        # likely cause
+        causes: list[str] = []
+        near_load = False
+        if "node" in details:
+            loaded = np.unique(np.r_[self.model.host.get("ledge_n0", []), self.model.host.get("ledge_n1", [])])
+            near_load = bool(len(loaded)) and bool(np.isin(bad_n, loaded.astype(np.int64)).any())
+        if gas_bad or "contact_energy" in bad_terms:
+            causes.append("the gas-rock contact (lower coupling.stiffness_factor / coupling.contact_stiffness, or "
+                          "simulation.dt_safety)")
+        if near_load:
+            causes.append("a pressure pulse on a loaded boundary or borehole (check its peak [Pa] and rise time)")
+        dt_cause = (f"the time step (dt = {self.dt:.3e} s = {self.dt / self.model.stable_dt:.2f} x the stable "
+                    "rock step; reduce simulation.dt_safety)")
+        if self.dt > self.model.stable_dt * (1 + 1e-9):
+            causes.insert(0, dt_cause)                 # above the stability limit: certainly the time step
+        else:
+            causes.append(dt_cause)
+        details["likely_causes"] = causes
+        details["where"] = where
+        msg = (f"non-finite energy ({', '.join(bad_terms)}) at step {self.steps} (t = {self.time:.4e} s); "
+               f"first non-finite: {'; '.join(where) if where else 'no node, element or particle (energy sums only)'}. "
+               f"Likely cause: {causes[0]}" + (f"; else {'; '.join(causes[1:])}" if len(causes) > 1 else "")
+               + f". The histories up to here and summary.json (status 'failed') are in {self.out_dir}")
+        return msg, details
 
     # ------------------------------------------------------------------ results
     def summary(self, wall: float) -> dict:
         m, st = self.model, self.state
         mode = st.pair_mode.numpy()
         e = self.energies()
-        err, rel = budget_error(e, self.initial_stored)
+        err, rel = budget_error(e, self.initial_stored + self.initial_dissipated)
         counts = self.fracture.counts(mode)
         out = {
             "blastfrac_version": __version__,
@@ -316,15 +440,21 @@ class Simulation:
             "broken_springs": {"tensile": counts["tensile"], "shear": counts["shear"],
                                "total": counts["tensile"] + counts["shear"]},
             "fracture_degree": self.fracture.sample(mode),
-            "energy": {**e, "initial_stored": self.initial_stored, "budget_error": err, "budget_error_relative": rel},
+            "energy": {**e, "initial_stored": self.initial_stored, "initial_dissipated": self.initial_dissipated,
+                       "budget_error": err, "budget_error_relative": rel},
             "elastic": m.elastic.as_dict(),
             "insitu_stage": self.insitu_report,
             "cracks": self.crack_statistics(),
             "monitors": self.monitors.report(),
+            "status": "completed",
+            "warnings": list(self.warnings),
         }
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
                                 "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}
+        if not self._budget_warned and abs(rel) > self.scenario.output.budget_warning:
+            self._check_budget(err, rel, final=True)   # the final state is over the limit: warn now
+            out["warnings"] = list(self.warnings)
         return out
 
     def crack_statistics(self) -> list[dict]:

@@ -39,7 +39,7 @@ def run(args) -> int:
     try:
         s = sim.run(progress=False if args.no_progress else None)
     except SimulationError as e:
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {e}", file=sys.stderr)   # summary.json (status 'failed') and the CSVs are written
         return 1
     b = s["broken_springs"]
     print(f"{s['steps']} steps, t = {s['simulated_time'] * 1e6:.2f} µs, wall {s['wall_time_s']:.1f} s; "

@@ -3,6 +3,12 @@
 Each frame holds the deformed blocks (triangles, with displacement and velocity at nodes and
 the stress tensor per element) and the cracks as line cells on the broken interfaces, with
 ``crack_mode`` 1 = tensile, 2 = shear (mode of the first spring of the edge that broke).
+
+Both cell fields exist on both cell blocks, so that no reader sees a hole or a NaN: ``crack_mode``
+is 0 on the triangles, ``stress`` is 0 on the crack lines (a crack carries no stress tensor; select
+the blocks with ``crack_mode == 0``). The stress is the full 3×3 plane-strain tensor [Pa], tension
+positive, with σ_zz = ν(σ_xx + σ_yy), ν = λ/(2(λ + μ)) the Poisson ratio of the blocks (ε_zz = 0).
+Every file is written atomically (io/atomic.py): a killed run leaves whole frames only.
 """
 
 from __future__ import annotations
@@ -12,6 +18,25 @@ from xml.sax.saxutils import quoteattr
 
 import meshio
 import numpy as np
+
+from .atomic import write_atomic, write_text_atomic
+
+
+def block_poisson_ratio(model) -> float:
+    """ν of the blocks, λ/(2(λ + μ)) from their Lamé constants (model.lam, model.mu)."""
+    return float(model.lam) / (2.0 * (float(model.lam) + float(model.mu)))
+
+
+def stress_tensor(sig: np.ndarray, nu: float) -> np.ndarray:
+    """[E, 9] row-major 3×3 plane-strain tensors from (σxx, σyy, σxy) rows; σzz = ν(σxx + σyy)."""
+    stress = np.zeros((len(sig), 9))
+    stress[:, 0], stress[:, 4], stress[:, 1], stress[:, 3] = sig[:, 0], sig[:, 1], sig[:, 2], sig[:, 2]
+    stress[:, 8] = nu * (sig[:, 0] + sig[:, 1])
+    return stress
+
+
+def _write_mesh(path: Path, mesh: meshio.Mesh) -> None:
+    write_atomic(path, lambda tmp: meshio.write(tmp, mesh, file_format="vtu", binary=True))
 
 
 def crack_segments(model, mode: np.ndarray, tbreak: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -42,12 +67,11 @@ class ParaviewSeries:
         tri = np.arange(len(x)).reshape(-1, 3)
         cells = [("triangle", tri)]
         n_e, n_c = len(tri), len(seg)
-        stress = np.zeros((n_e, 9))
-        stress[:, 0], stress[:, 4], stress[:, 1], stress[:, 3] = sig[:, 0], sig[:, 1], sig[:, 2], sig[:, 2]
+        stress = stress_tensor(sig, block_poisson_ratio(model))
         cell_data = {"stress": [stress], "crack_mode": [np.zeros(n_e, np.int32)]}
         if n_c:
             cells.append(("line", seg))
-            cell_data["stress"].append(np.full((n_c, 9), np.nan))
+            cell_data["stress"].append(np.zeros((n_c, 9)))
             cell_data["crack_mode"].append(cmode.astype(np.int32))
         u = x - X
         mesh = meshio.Mesh(
@@ -57,13 +81,13 @@ class ParaviewSeries:
             cell_data=cell_data,
         )
         fname = f"{self.name}_{len(self.frames):04d}.vtu"
-        meshio.write(self.dir / fname, mesh, binary=True)
+        _write_mesh(self.dir / fname, mesh)
         self.frames.append((t, fname))
         self._write_pvd()
 
     def _write_pvd(self) -> None:
         rows = "\n".join(f'    <DataSet timestep="{t:.9e}" file={quoteattr(f)}/>' for t, f in self.frames)
-        (self.dir / f"{self.name}.pvd").write_text(
+        write_text_atomic(self.dir / f"{self.name}.pvd",
             '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
             f"{rows}\n  </Collection>\n</VTKFile>\n"
         )
@@ -87,6 +111,6 @@ class GasSeries(ParaviewSeries):
                         "burn_fraction": f["burn_fraction"], "relative_volume": f["relative_volume"]},
         )
         fname = f"{self.name}_{len(self.frames):04d}.vtu"
-        meshio.write(self.dir / fname, mesh, binary=True)
+        _write_mesh(self.dir / fname, mesh)
         self.frames.append((t, fname))
         self._write_pvd()

@@ -101,9 +101,12 @@ def resolved_dict(scenario: Scenario) -> dict:
 
 
 def write_resolved(scenario: Scenario, path: str | Path) -> None:
-    Path(path).write_text(
+    from ..io.atomic import write_text_atomic
+
+    write_text_atomic(
+        path,
         "# blastfrac resolved scenario: every value used by the run, defaults included\n"
-        + tomli_w.dumps(resolved_dict(scenario))
+        + tomli_w.dumps(resolved_dict(scenario)),
     )
 
 

@@ -65,6 +65,11 @@ class OutputConfig(_Strict):
         description="Times [s] at which displacement (and gas) snapshots are kept for the Fig. 4-style panel; "
         "default: four equally spaced times.",
     )
+    budget_warning: float = Field(
+        0.05, gt=0, le=1,
+        description="Relative energy-budget error (|budget_error_relative|) above which the run warns on stderr "
+        "(once) and lists a warning in summary.json → warnings; in (0, 1], default 0.05 (5 %).",
+    )
 
     @field_validator("snapshot_times")
     @classmethod
