@@ -34,6 +34,7 @@ validate: $(VENV)/.installed-test
 	$(BIN)/python -m pytest -q -m slow
 	for s in $(EXAMPLES); do $(BIN)/blastfrac run $$s || exit 1; done
 	$(BIN)/python examples/confined_blast/compare.py --out out/confined_blast_compare
+	$(BIN)/python examples/rock_fronts/candidates.py --out out/rock_fronts
 
 ## bench: performance suite (throughput and scaling), results printed and appended to benchmarks/
 bench: $(VENV)/.installed
