@@ -33,7 +33,7 @@ from blastfrac.mpm.apic import (
     affine_inertia_np,
     affine_kinetic_energy_np,
 )
-from blastfrac.mpm.burn import BURN_MODES, lighting_times
+from blastfrac.mpm.burn import BURN_MODES, lighting_times, line_lighting_times
 from blastfrac.mpm.grid import Grid, GridSpec
 from blastfrac.mpm.kernels_burn import update_burn
 from blastfrac.mpm.kernels_eos import update_jwl_state
@@ -79,6 +79,21 @@ def grid_from_config(config) -> GridSpec:
     return GridSpec.from_bounds(lo, hi, g.cell_size)
 
 
+def boundary_walls(config, spec: GridSpec) -> dict[str, tuple[float, str]]:
+    """The non-open sides of ``config.grid.boundaries``: side -> (wall coordinate [m], 'slip' | 'fixed').
+
+    The wall is the box of :func:`grid_from_config` widened outwards to grid lines: the nodes 2 cells inside the
+    grid's edges (``GridSpec.from_bounds`` pads 2 cells and aligns), which leaves two ghost-node rows behind it.
+    """
+    b = getattr(config.grid, "boundaries", None)
+    if b is None:
+        return {}
+    h = spec.h
+    xu, yu = spec.upper
+    pos = {"left": spec.x0 + 2 * h, "right": xu - 2 * h, "bottom": spec.y0 + 2 * h, "top": yu - 2 * h}
+    return {side: (pos[side], getattr(b, side)) for side in pos if getattr(b, side) != "open"}
+
+
 class MPMSolver:
     """Explicit MUSL MPM for JWL detonation products (or a linear-elastic solid, for tests).
 
@@ -113,15 +128,25 @@ class MPMSolver:
         x, vol, _ = seed_charges(config.charges, spec, opts.ppc, mode=config.seeding)
         if particle_filter is not None:
             x, vol = particle_filter(x, vol)
+        t_l = np.full(len(x), np.inf)
         if config.detonation_points:
             pts = np.array([d.position for d in config.detonation_points], float)
             delays = np.array([d.delay for d in config.detonation_points], float)
-        else:
+            t_l = lighting_times(x, pts, delays, params.D)
+        elif not config.detonation_lines:
             pts = np.array([charge_area_centroid(c)[1] for c in config.charges])
-            delays = np.zeros(len(pts))
-        t_l = lighting_times(x, pts, delays, params.D)
+            t_l = lighting_times(x, pts, np.zeros(len(pts)), params.D)
+        for dl in config.detonation_lines:
+            vel = dl.velocity if dl.velocity is not None else params.D
+            t_l = np.minimum(t_l, line_lighting_times(x, dl.start, dl.end, dl.delay, vel, params.D))
         self.config = config
         self._build(x, vol, spec, params, opts, device, light_time=t_l)
+        self.walls = boundary_walls(config, spec)
+        key = {"left": "xmin", "right": "xmax", "bottom": "ymin", "top": "ymax"}
+        for kind in ("slip", "fixed"):
+            kw = {key[side]: val for side, (val, k) in self.walls.items() if k == kind}
+            if kw:
+                self.grid.set_walls(**kw, kind=kind)
 
     @classmethod
     def from_arrays(
@@ -139,6 +164,7 @@ class MPMSolver:
         """Build from host arrays: x [n,2] m, vol [n] m^2, optional v [n,2] m/s, light_time [n] s, burn [n]."""
         self = cls.__new__(cls)
         self.config = None
+        self.walls = {}
         self._build(x, vol, grid, material, options or MPMOptions(), device, v=v, light_time=light_time, burn=burn)
         return self
 

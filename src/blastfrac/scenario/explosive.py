@@ -7,6 +7,7 @@ custom JWL set (``constants``), never both.  Example::
     name = "emulsion"
     charges = [{ kind = "circle", center = [0.0, 0.0], radius = 0.02 }]
     detonation_points = [{ position = [0.0, 0.0], delay = 0.0 }]
+    detonation_lines = [{ start = [0.0, -0.02], end = [0.0, 0.02], delay = 0.0, velocity = 7000.0 }]
     [explosive.grid]
     cell_size = 0.002
     margin = 0.06
@@ -62,6 +63,10 @@ class CircleCharge(_Model):
         """p inside or on the circle (within tol·radius)."""
         return math.dist(p, self.center) <= self.radius * (1 + tol)
 
+    def meets_segment(self, a: Point, b: Point, tol: float = 1e-9) -> bool:
+        """The segment ab has a point inside or on the circle (within tol·radius)."""
+        return geo.seg_dist(self.center, a, b) <= self.radius * (1 + tol)
+
 
 class PolygonCharge(_Model):
     """A polygonal charge; vertices in order (either orientation)."""
@@ -96,6 +101,13 @@ class PolygonCharge(_Model):
         (x0, y0), (x1, y1) = self.bbox
         return geo.point_in_polygon(p, self.vertices) or geo.polygon_dist(p, self.vertices) <= tol * max(x1 - x0, y1 - y0)
 
+    def meets_segment(self, a: Point, b: Point, tol: float = 1e-9) -> bool:
+        """The segment ab has a point inside or on the polygon."""
+        if self.contains(a, tol) or self.contains(b, tol):
+            return True
+        v = self.vertices
+        return any(geo.segments_touch(a, b, v[i], v[(i + 1) % len(v)]) for i in range(len(v)))
+
 
 Charge = Annotated[CircleCharge | PolygonCharge, Field(discriminator="kind")]
 
@@ -105,6 +117,38 @@ class DetonationPoint(_Model):
 
     position: Point = Field(description="initiation point (x, y) [m]")
     delay: float = Field(default=0.0, ge=0, description="initiation delay [s]")
+
+
+class DetonationLine(_Model):
+    """A line initiator (detonating cord) from ``start`` to ``end``, fired at ``start`` at ``delay``; its front runs
+    along the segment at ``velocity``: the point at distance s from ``start`` lights at delay + s / velocity, and a
+    particle at X lights at min over the segment points y of (their lighting time + |X - y| / D)."""
+
+    start: Point = Field(description="end of the cord that is fired (x, y) [m]")
+    end: Point = Field(description="other end of the cord (x, y) [m]")
+    delay: float = Field(default=0.0, ge=0, description="firing time of ``start`` [s]")
+    velocity: float | None = Field(
+        default=None, gt=0, description="speed of the lighting front along the cord [m/s]; default: the explosive's D"
+    )
+
+    @model_validator(mode="after")
+    def _length(self) -> DetonationLine:
+        if self.start == self.end:
+            raise ValueError("end: equals start; a detonation line needs two distinct ends")
+        return self
+
+
+BoundaryKind = Literal["open", "fixed", "slip"]
+
+
+class GridBoundaries(_Model):
+    """Conditions on the four sides of the grid box: 'open' (particles that leave are deactivated), 'fixed' (grid
+    velocity 0 on the side) or 'slip' (normal grid velocity 0), as image walls at rest (:mod:`blastfrac.mpm.grid`)."""
+
+    left: BoundaryKind = Field(default="open", description="side x = xmin")
+    right: BoundaryKind = Field(default="open", description="side x = xmax")
+    bottom: BoundaryKind = Field(default="open", description="side y = ymin")
+    top: BoundaryKind = Field(default="open", description="side y = ymax")
 
 
 class GridConfig(_Model):
@@ -118,6 +162,11 @@ class GridConfig(_Model):
         default=None, ge=0, description="clearance added around the charges' box [m]; default: the box's larger side"
     )
     points_per_cell: int = Field(default=2, ge=1, le=6, description="material points per cell per direction [-]")
+    boundaries: GridBoundaries = Field(
+        default_factory=GridBoundaries, description="side conditions of the grid box (left, right, bottom, top: "
+        "'open', 'fixed' or 'slip'); a wall lies on the box (bounds, or the charges' box plus margin) widened outwards "
+        "to the nearest grid lines (multiples of cell_size); default: all open"
+    )
 
     @model_validator(mode="after")
     def _check_bounds(self) -> GridConfig:
@@ -150,6 +199,10 @@ class ExplosiveConfig(_Model):
     charges: list[Charge] = Field(min_length=1, description="charge regions filled with material points")
     detonation_points: list[DetonationPoint] = Field(
         default_factory=list, description="initiation points; default: the centroid of each charge, no delay"
+    )
+    detonation_lines: list[DetonationLine] = Field(
+        default_factory=list, description="line initiators (detonating cords), lit together with detonation_points: "
+        "t_l is the earliest over both; with neither, each charge lights at its centroid"
     )
     grid: GridConfig = Field(description="background grid")
     seeding: Literal["conformal", "lattice"] = Field(
@@ -221,6 +274,13 @@ class ExplosiveConfig(_Model):
             for i in range(k):
                 if dp == self.detonation_points[i]:
                     raise ValueError(f"detonation_points[{k}]: repeats detonation_points[{i}]")
+        for k, dl in enumerate(self.detonation_lines):
+            if not any(ch.meets_segment(dl.start, dl.end) for ch in self.charges):
+                raise ValueError(f"detonation_lines[{k}]: the segment ({dl.start[0]:.6g}, {dl.start[1]:.6g})–"
+                                 f"({dl.end[0]:.6g}, {dl.end[1]:.6g}) neither lies in nor touches any charge")
+            for i in range(k):
+                if dl == self.detonation_lines[i]:
+                    raise ValueError(f"detonation_lines[{k}]: repeats detonation_lines[{i}]")
         return self
 
     def jwl(self):
@@ -233,4 +293,4 @@ class ExplosiveConfig(_Model):
         return get_explosive(self.name)
 
 
-__all__ = ["ExplosiveConfig", "JWLConstants", "CircleCharge", "PolygonCharge", "DetonationPoint", "GridConfig", "BurnConfig"]
+__all__ = ["ExplosiveConfig", "JWLConstants", "CircleCharge", "PolygonCharge", "DetonationPoint", "DetonationLine", "GridConfig", "GridBoundaries", "BurnConfig"]
