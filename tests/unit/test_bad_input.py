@@ -308,6 +308,18 @@ SET_CASES = [
     ("unknown explosive", CIRC, ["explosive.name='dynamite'"], ["explosive.name", "unknown explosive"]),
     ("huge seed", BP, ["simulation.seed=99999999999999999999"], ["simulation.seed"]),
     ("huge density", BP, ["rock.density=1e300"], ["rock.density", "less than or equal"]),
+    ("detonation line in the rock", CIRC, ["explosive.detonation_lines=[{start=[0.05, 0.05], end=[0.06, 0.06]}]"],
+     ["explosive.detonation_lines[0]", "neither lies in nor touches any charge"]),
+    ("detonation line of zero length", CIRC, ["explosive.detonation_lines=[{start=[0.0, 0.0], end=[0.0, 0.0]}]"],
+     ["explosive.detonation_lines[0].end", "equals start"]),
+    ("detonation line with a negative velocity", CIRC,
+     ["explosive.detonation_lines=[{start=[0.0, 0.0], end=[0.004, 0.0], velocity=-1.0}]"],
+     ["explosive.detonation_lines[0].velocity"]),
+    ("detonation line delay NaN", CIRC,
+     ["explosive.detonation_lines=[{start=[0.0, 0.0], end=[0.004, 0.0], delay=nan}]"],
+     ["explosive.detonation_lines[0].delay", "finite"]),
+    ("grid side of an unknown kind", CIRC, ["explosive.grid.boundaries={left='wall'}"],
+     ["explosive.grid.boundaries"]),
 ]
 
 
