@@ -73,7 +73,7 @@ class CsvHistory:
         w = csv.writer(buf)
         w.writerow(self.header())
         for r in self.rows:
-            w.writerow([f"{v:.9g}" for v in r])
+            w.writerow([f"{v + 0.0 if isinstance(v, float) else v:.9g}" for v in r])   # no "-0" for a negative zero
         write_text_atomic(self.path, buf.getvalue())
 
     def column(self, name: str) -> list[float]:
