@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import scipy.sparse.linalg as spla
 
 from blastfrac.analysis.monitors import MonitorSet
-from blastfrac.calibration.elastic import stiffness_matrix
 from blastfrac.model.builder import ModelBuilder
 from blastfrac.scenario import ScenarioError
 from blastfrac.scenario.schema import Monitor
 from conftest import scenario
+from verification.static_helpers import static_pressurised_hole
 
 SCATTER = 0.2          # ± relative per-element perturbation (uniform): std SCATTER/√3
 K_SPRING = 5.0e15      # Pa/m
@@ -178,7 +177,7 @@ def test_lame_cylinder_static_solution_monitors():
                             "mesh_size": 0.0025, "mesh_size_near": 0.0006, "refinement_distance": 0.02})
     m = ModelBuilder(sc).finalize("cpu")
     X = m.host["node_X"]
-    u = _static_displacement(m, X, a, p)
+    u = static_pressurised_hole(m, a, p)
     sigma = _cst_stress(X, u, m.lam, m.mu)
     th = np.linspace(0, 2 * np.pi, 12, endpoint=False)
     P = 3 * a * np.stack([np.cos(th), np.sin(th)], 1)
@@ -201,31 +200,6 @@ def test_lame_cylinder_static_solution_monitors():
     assert np.abs(res["averaged"].mean(axis=0)).max() < 0.01    # unbiased around the ring
     assert np.all(rms_one > 2.5 * rms)
     assert np.abs(res["single"]).max() > 0.08
-
-
-def _static_displacement(m, X: np.ndarray, a: float, p: float) -> np.ndarray:
-    """Nodal displacements [3E, 2] [m] of the intact model under inner pressure p [Pa] on the wall r = a."""
-    K = stiffness_matrix(m).tocsr()
-    s0 = m.topology.boundary_slots
-    s1 = 3 * (s0 // 3) + (s0 % 3 + 1) % 3                  # next node of the same block: edge s0 → s1
-    r = np.hypot(X[:, 0], X[:, 1])
-    on = (r[s0] < a * (1 + 1e-3)) & (r[s1] < a * (1 + 1e-3))
-    s0, s1 = s0[on], s1[on]
-    d = X[s1] - X[s0]
-    nL = np.stack([d[:, 1], -d[:, 0]], 1)                   # L × outward normal of the block (into the hole)
-    assert np.all(np.einsum("ij,ij->i", nL, X[s0] + X[s1]) < 0)
-    f = np.zeros_like(X)
-    np.add.at(f, s0, -0.5 * p * nL)
-    np.add.at(f, s1, -0.5 * p * nL)
-    assert np.abs(f.sum(0)).max() < 1e-9 * p * a
-    b = r.max()
-    i0 = np.argmin(np.hypot(X[:, 0] - b, X[:, 1]))
-    i1 = np.argmin(np.hypot(X[:, 0] + b, X[:, 1]))
-    free = np.setdiff1d(np.arange(2 * len(X)), [2 * i0, 2 * i0 + 1, 2 * i1 + 1])
-    u = np.zeros(2 * len(X))
-    u[free] = spla.spsolve(K[free][:, free].tocsc(), f.ravel()[free])
-    assert np.abs(K @ u - f.ravel()).max() < 1e-6 * np.abs(f).max()
-    return u.reshape(-1, 2)
 
 
 def _cst_stress(X: np.ndarray, u: np.ndarray, lam: float, mu: float) -> np.ndarray:

@@ -21,6 +21,7 @@ import pytest
 from blastfrac.cdem.solver import CDEMSolver
 from blastfrac.model.builder import ModelBuilder
 from conftest import ROCK, scenario
+from verification.static_helpers import static_pressurised_hole
 
 E, NU, RHO = ROCK["youngs_modulus"], ROCK["poisson_ratio"], ROCK["density"]
 LAM, MU = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
@@ -100,41 +101,16 @@ def lame_wall_displacement(h_near: float, rock: dict | None = None) -> tuple[flo
     """Static Lamé cylinder (a = 5 mm, b = 50 mm, inner pressure p) of the model's linear stiffness.
 
     Returns (mean radial wall displacement [m], Lamé's u(a) for the input rock [m], mean u at r = 2a [m]
-    against Lamé there, as a ratio). The pressure acts as p·L/2 per node on every wall edge, as the
-    pressure boundary does (cdem/boundary.py); the outer surface is free; three dofs hold the rigid modes.
+    against Lamé there, as a ratio). The solve is verification/static_helpers.static_pressurised_hole.
     """
-    import scipy.sparse.linalg as spla
-
-    from blastfrac.calibration.elastic import stiffness_matrix
-
     a, b, p = 0.005, 0.05, 100e6
     sc = scenario(rock=rock or _default_rock(),
                   geometry={"domain": {"type": "disc", "radius": b}, "boreholes": [{"radius": a}],
                             "mesh_size": 4 * h_near, "mesh_size_near": h_near, "refinement_distance": 0.02})
     m = ModelBuilder(sc).finalize("cpu")
     X = m.host["node_X"]
-    K = stiffness_matrix(m)
-    f = np.zeros(K.shape[0])
-    topo = m.topology
-    for slot, tag in zip(topo.boundary_slots, topo.boundary_slot_tags):
-        if tag != "hole0":
-            continue
-        n0, n1 = int(slot), int(3 * (slot // 3) + (slot % 3 + 1) % 3)
-        d = X[n1] - X[n0]
-        force = -0.5 * p * np.array([d[1], -d[0]])          # −p·L·n_out/2 per node (n_out into the hole)
-        for n in (n0, n1):
-            f[2 * n:2 * n + 2] += force
+    U = static_pressurised_hole(m, a, p)
     r = np.hypot(X[:, 0], X[:, 1])
-    far = np.argsort(-r)[:1]
-    i0 = int(far[0])
-    i1 = int(np.argmax(-X[:, 0]))                              # opposite side
-    fixed = np.zeros(K.shape[0], bool)
-    fixed[[2 * i0, 2 * i0 + 1, 2 * i1 + 1 if abs(X[i1, 0]) > abs(X[i1, 1]) else 2 * i1]] = True
-    free = ~fixed
-    u = np.zeros(K.shape[0])
-    u[free] = spla.spsolve(K[free][:, free].tocsc(), f[free])
-    U = u.reshape(-1, 2)
-    # remove any rigid rotation the three pins left (the solution is axisymmetric)
     ur = np.einsum("ij,ij->i", U, X / r[:, None])
     nu = NU
 

@@ -42,6 +42,18 @@ def constrained_inverse(P: wp.mat22d, D: wp.mat22d, a: wp.float64):
     return P @ wp.inverse(P @ A @ P + (eye - P) * a) @ P
 
 
+@wp.func
+def store_block(v: wp.array(dtype=wp.vec2d), x: wp.array(dtype=wp.vec2d), n0: int,
+                w0: wp.vec2d, w1: wp.vec2d, w2: wp.vec2d, dt: wp.float64):
+    """Write the new velocities w_k [m/s] of block nodes n0 … n0+2 and move them: x += Δt·w [m]."""
+    v[n0] = w0
+    v[n0 + 1] = w1
+    v[n0 + 2] = w2
+    x[n0] = x[n0] + w0 * dt
+    x[n0 + 1] = x[n0 + 1] + w1 * dt
+    x[n0 + 2] = x[n0 + 2] + w2 * dt
+
+
 @wp.kernel
 def integrate_blocks(
     node_mass: wp.array(dtype=wp.float64),
@@ -80,12 +92,7 @@ def integrate_blocks(
         u0 = (q0 - sf * b) * ia
         u1 = (q1 - sf * b) * ia
         u2 = (q2 - sf * b) * ia
-        v[n0] = u0
-        v[n0 + 1] = u1
-        v[n0 + 2] = u2
-        x[n0] = x[n0] + u0 * dt
-        x[n0 + 1] = x[n0 + 1] + u1 * dt
-        x[n0 + 2] = x[n0 + 2] + u2 * dt
+        store_block(v, x, n0, u0, u1, u2, dt)
         return
     H0 = eye
     H1 = eye
@@ -135,12 +142,7 @@ def integrate_blocks(
     absorbed = wp.dot(vm0, D0 @ vm0) + wp.dot(vm1, D1 @ vm1) + wp.dot(vm2, D2 @ vm2)
     if absorbed != wp.float64(0.0):
         wp.atomic_add(energy_acc, 1, wp.float64(2.0) * absorbed)
-    v[n0] = w0
-    v[n0 + 1] = w1
-    v[n0 + 2] = w2
-    x[n0] = x[n0] + w0 * dt
-    x[n0 + 1] = x[n0 + 1] + w1 * dt
-    x[n0 + 2] = x[n0 + 2] + w2 * dt
+    store_block(v, x, n0, w0, w1, w2, dt)
 
 
 def launch_integrate(model, state, dt: float, alpha: float) -> None:
