@@ -59,6 +59,7 @@ class Simulation:
         self.cdem = CDEMSolver(self.model, block_contact=scenario.rock.block_contact and self.model.breakable == 1)
         self.gas = None
         self.coupler = None
+        self.crack_gas = None
         self.gas_report: dict = {}
         if scenario.explosive is not None:
             self._build_explosive()
@@ -107,6 +108,14 @@ class Simulation:
         self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval,
                                       force_cap=cp.force_cap, surface_forces=cp.surface_forces,
                                       pressure_preload=cp.pressure_preload)
+        if sc.crack_gas.enabled:
+            from .coupling.crack_gas import CrackGas
+
+            cg = sc.crack_gas
+            self.crack_gas = CrackGas(self.model, self.gas, cg.viscosity, cg.min_aperture,
+                                      cg.mouth_radius if cg.mouth_radius is not None else self.gas.spec.h,
+                                      rebuild_interval=cp.rebuild_interval, particle_floor=cg.particle_floor)
+            self.coupler.mass_floor = cg.particle_floor      # particles that feed cracks get lighter
         self.gas_report = {
             "particles": self.gas.n, "removed_at_seeding": removed[0], "grid_nodes": self.gas.spec.node_count,
             "cell_size": self.gas.spec.h, "contact_stiffness": kc, "contact_dt": self.coupler.stable_dt(),
@@ -130,6 +139,8 @@ class Simulation:
         self.cdem.forces(st, dt, self.time)                # springs + failure, CST, loads, block contact
         if couple:
             self.coupler.apply(st, dt)                     # particle–edge contact: gas f_ext_p, rock reactions
+            if self.crack_gas is not None:
+                self.crack_gas.apply(st, dt)               # gas in cracks: face loads, flow, exchange at mouths
             self.gas.to_grid(dt)                           # P2G with the contact forces
             self.gas.update_grid(dt)
         self.cdem.integrate(st, dt, self.alpha)            # central difference on rock nodes
@@ -222,6 +233,8 @@ class Simulation:
                        "external_work"]
         if self.gas is not None:
             energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_energy"]
+            if self.crack_gas is not None:
+                energy_cols += ["crack_gas"]
         energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"], unit="J/m")
         wall0 = _time.perf_counter()
         try:
@@ -302,6 +315,8 @@ class Simulation:
             e.update(gas_energies(self.gas))
             c = self.coupler.energies()
             e["contact_energy"] = c["contact_energy"]
+            if self.crack_gas is not None:
+                e["crack_gas"] = self.crack_gas.energies()["crack_gas"]
         return e
 
     def _gas_pressure(self, pts: np.ndarray) -> np.ndarray:
@@ -452,6 +467,8 @@ class Simulation:
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
                                 "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}
+            if self.crack_gas is not None:
+                out["crack_gas"] = self.crack_gas.report()
         if not self._budget_warned and abs(rel) > self.scenario.output.budget_warning:
             self._check_budget(err, rel, final=True)   # the final state is over the limit: warn now
             out["warnings"] = list(self.warnings)

@@ -60,14 +60,13 @@ def gas_energies(gas) -> dict[str, float]:
 
     Particles that left the grid keep their last state, so their energy stays in the books.
     explosive_released: Σ F·E0·V0 (chemical energy liberated by the burn so far);
-    gas_internal: Σ ie − Σ (1 − F)·E0·V0 (internal energy of the burnt products);
+    gas_internal: Σ ie − Σ (1 − F)·E0·V0 (internal energy of the burnt products), V0 the seeded volumes;
     gas_kinetic: Σ ½ m v², plus with APIC transfer the affine part Σ ½ m tr(B D⁻¹ Bᵀ) of the active particles
     (mpm/apic.py; a particle that left the grid has no affine field).
     """
-    P = gas.material
     ie = gas.ie.numpy()
     burn = gas.burn.numpy()
-    chem0 = P.E0 * gas.vol0.numpy()
+    chem0 = gas.chem0       # E0·V0 at seeding: V0 follows the mass of a particle that feeds a crack
     v = gas.v.numpy()
     ke = float(0.5 * (gas.mass.numpy() * np.einsum("ij,ij->i", v, v)).sum())
     if getattr(gas, "apic", False):
@@ -81,7 +80,7 @@ def gas_energies(gas) -> dict[str, float]:
 
 # the terms that hold or have taken energy; the supplied side is initial stored + external work + explosive
 HELD_TERMS = ("kinetic", "strain", "springs", "fracture", "friction", "viscous_absorbed", "damping",
-              "gas_kinetic", "gas_internal", "contact_energy")
+              "gas_kinetic", "gas_internal", "contact_energy", "crack_gas")
 
 
 def budget_error(e: dict[str, float], initial_stored: float) -> tuple[float, float]:

@@ -73,6 +73,7 @@ class GasRockCoupler:
         self.n_exposed = 0
         self._since = self.rebuild_interval
         self._dt: float | None = None
+        self.mass_floor = 1.0        # lightest a particle can become, as a fraction of its seeded mass (crack gas)
 
     # ------------------------------------------------------------------ stable step
     def stable_dt(self) -> float:
@@ -91,7 +92,7 @@ class GasRockCoupler:
         (6 for the quadratic B-spline, 9.3 for uGIMP at 2 points per cell; C = 2.5 for B-splines at r_max = h/2).
         In the single-hole example the rock-node bound is the smaller one, so C leaves its step unchanged.
         """
-        m_p = float(self.mpm.mass.numpy().min()) if self.mpm.n else math.inf
+        m_p = self.mass_floor * float(self.mpm.mass.numpy().min()) if self.mpm.n else math.inf
         om2_p = 2.0 * self.kc * self.lever_stiffness_factor() / m_p
         L = self.model.mesh.edge_lengths()                              # [E, 3], edge k runs k → k+1
         adj = np.stack([L[:, 0] + L[:, 2], L[:, 1] + L[:, 0], L[:, 2] + L[:, 1]], 1).reshape(-1)

@@ -221,6 +221,7 @@ class MPMSolver:
                 self.p.assign(p0)
                 self.stress.assign(-p0[:, None, None] * np.eye(2)[None])
             self._chem0 = P.E0 * vol
+            self.chem0 = P.E0 * vol          # E0·V0 of each particle at seeding [J/m] (analysis.energy)
         else:
             self.cs.assign(np.full(n, material.p_wave_speed))
         self._check_in_grid(x)
@@ -272,6 +273,7 @@ class MPMSolver:
         if v is not None:
             self.v.assign(np.asarray(v, F64).reshape(-1, 2))
         self._chem0 = ie.copy()
+        self.chem0 = P.E0 * vol0
 
     def _check_in_grid(self, x: np.ndarray) -> None:
         s = self.spec

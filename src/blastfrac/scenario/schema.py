@@ -609,6 +609,34 @@ class CouplingConfig(_Strict):
     )
 
 
+class CrackGasConfig(_Strict):
+    """Detonation gas inside cracks narrower than a material point (coupling/crack_gas.py, docs/explosive.md)."""
+
+    enabled: bool = Field(
+        False, description="Carry the MPM gas into broken interfaces connected to the gas-filled hole as a network of "
+        "crack cells whose pressure loads both crack faces [-]. Needs [explosive]. Off: gas enters a crack only as "
+        "particles, when the crack is wider than a particle.",
+    )
+    viscosity: float = Field(
+        1e-4, gt=0, le=1.0, description="Dynamic viscosity μ of the products in the cubic law "
+        "ṁ = ρw³Δp/(12μΔx) [Pa·s]; 1e-4 is that of a gas at about 3000 K. The flux never exceeds the choked "
+        "flux of the donor, which governs wide, steeply loaded cracks whatever μ is.",
+    )
+    min_aperture: float = Field(
+        5e-6, gt=0, le=1e-3, description="Floor of a crack cell's volume per unit length (aperture) [m]: the gas "
+        "of a closed crack is held at this aperture (its pressure then capped at P_CJ). It bounds the stiffness "
+        "γp·L/w_min of the gas on the face nodes (below the rock's springs for 5 µm at P_CJ).",
+    )
+    mouth_radius: float | None = Field(
+        None, gt=0, description="A broken interface ending on a surface vertex (borehole wall, free face) is fed by "
+        "the nearest fully burnt particle within this distance of its end [m]; default the MPM cell size.",
+    )
+    particle_floor: float = Field(
+        0.5, ge=0.05, le=0.95, description="A particle feeding a crack keeps at least this fraction of its initial "
+        "mass [-]; the gas-rock contact's stable step is taken with the floor mass.",
+    )
+
+
 # --------------------------------------------------------------------------- scenario
 class Scenario(_Strict):
     """A complete blastfrac run."""
@@ -631,9 +659,12 @@ class Scenario(_Strict):
         None, description="MPM explosive (JWL products, programmed burn); see blastfrac.scenario.explosive."
     )
     coupling: CouplingConfig = Field(default_factory=CouplingConfig)
+    crack_gas: CrackGasConfig = Field(default_factory=CrackGasConfig)
 
     @model_validator(mode="after")
     def _cross_checks(self) -> "Scenario":
+        if self.crack_gas.enabled and self.explosive is None:
+            raise ValueError("crack_gas.enabled: needs an [explosive] section (the crack gas comes from the MPM products)")
         sides = set(self.geometry.domain.sides) | {f"hole{i}" for i in range(len(self.geometry.boreholes))}
         for name in self.boundaries:
             if name not in sides:

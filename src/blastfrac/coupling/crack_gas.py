@@ -1,0 +1,233 @@
+"""CrackGas: detonation gas inside cracks narrower than a material point (docs/explosive.md, "Gas in cracks").
+
+Blast cracks open 0.1–0.2 mm near the hole, far below any affordable particle, so the MPM gas cannot enter
+them as particles. This stage carries the gas there as a network of *cells*, one per broken interface
+(coupling/kernels_crack_gas.py):
+
+* **Network.** A cell is an interface whose two springs have broken; cells sharing a mesh vertex are joined
+  (all broken interfaces at a vertex meet in the void there). A cell end on a surface vertex (borehole wall,
+  free face) with fully burnt gas within ``mouth_radius`` of it is a *mouth*, fed by the nearest particle.
+  Intact interfaces hold no gas and pass none: gas reaches a cell only along broken ones.
+* **State.** Each cell holds a gas mass and internal energy in its volume (the area between its faces, at
+  least ``min_aperture``·L); its pressure, sound speed and γ come from the products' JWL.
+* **Load.** The pressure pushes on the four face nodes with p·∂V/∂x, and the gas pays the work the faces
+  receive (mid-step velocities, as the particle–edge contact): the crack gas expands adiabatically.
+* **Flow.** Along each path (cell–cell at their shared vertex, cell–particle at a mouth) the mass flux is the
+  cubic law, capped by the choked flux of the donor (materials/crack_flow.py), carrying the donor's total
+  enthalpy. A donor gives at most ``cell_fraction`` (cells) or ``particle_fraction`` (particles) of its mass
+  per step, and a particle keeps at least ``particle_floor`` of its initial mass; mass and energy leave one
+  side exactly as they reach the other. A particle that gives (or takes) gas keeps its volume: its density
+  and pressure fall as in an isentropic expansion, and its reference volume V0 = m/ρ0 follows its mass.
+
+The network (wet-cell paths and mouths) is rebuilt every ``rebuild_interval`` steps; a cell that breaks in
+between is loaded from the next rebuild on. Units SI, per unit thickness.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import warp as wp
+
+from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasParticles,
+                                collect_cell_links, collect_mouths, crack_apply_flux, crack_cell_scale,
+                                crack_link_flux, crack_particle_scale, crack_refresh_particles, update_crack_cells)
+
+
+def static_cell_links(pair_nodes: np.ndarray, node_vertex: np.ndarray, X: np.ndarray):
+    """Every pair of interfaces that share a mesh vertex.
+
+    Returns (pairs [K, 2] interface indices, ends [K, 2] the end (0 = A, 1 = B) of each at the shared vertex,
+    dx [K] distance between their reference midpoints [m]) and the (interface, end) → vertex table [Q, 2].
+    """
+    iA, iB = pair_nodes[0::2, 0], pair_nodes[1::2, 0]
+    vert = np.stack([node_vertex[iA], node_vertex[iB]], 1)                 # [Q, 2]
+    mid = 0.5 * (X[iA] + X[iB])
+    q = np.repeat(np.arange(len(vert)), 2)
+    end = np.tile([0, 1], len(vert))
+    v = vert.ravel()
+    order = np.argsort(v, kind="stable")
+    v, q, end = v[order], q[order], end[order]
+    starts = np.r_[0, np.flatnonzero(v[1:] != v[:-1]) + 1, len(v)]
+    pa, pb, ea, eb = [], [], [], []
+    for s, t in zip(starts[:-1], starts[1:]):
+        n = t - s
+        if n < 2:
+            continue
+        i, j = np.triu_indices(n, 1)
+        pa.append(q[s + i]); pb.append(q[s + j]); ea.append(end[s + i]); eb.append(end[s + j])
+    if not pa:
+        z = np.zeros((0, 2), np.int64)
+        return z, z, np.zeros(0), vert
+    pairs = np.stack([np.concatenate(pa), np.concatenate(pb)], 1)
+    ends = np.stack([np.concatenate(ea), np.concatenate(eb)], 1)
+    dx = np.linalg.norm(mid[pairs[:, 0]] - mid[pairs[:, 1]], axis=1)
+    return pairs, ends, dx, vert
+
+
+class CrackGas:
+    """The crack-gas stage between the rock ``model`` and the MPM gas ``mpm``; buffers allocated once.
+
+    viscosity: μ of the products [Pa·s]; min_aperture: floor of a cell's volume per unit length [m];
+    mouth_radius: burnt gas within this distance of a cell end on a surface feeds it [m];
+    rebuild_interval: steps between network rebuilds [-]; cell_fraction, particle_fraction: most of its mass
+    a donor gives in one step [-]; particle_floor: a particle keeps at least this fraction of its initial mass [-].
+    """
+
+    def __init__(self, model, mpm, viscosity: float, min_aperture: float, mouth_radius: float,
+                 rebuild_interval: int = 5, cell_fraction: float = 0.5, particle_fraction: float = 0.2,
+                 particle_floor: float = 0.5, material=None, p_max: float | None = None):
+        """``mpm`` may be None (verification: cells only, no mouths); then give the products' ``material``
+        (JWLParams) and the pressure cap ``p_max`` [Pa]."""
+        self.model, self.mpm = model, mpm
+        d = model.device
+        self.device = d
+        topo = model.topology
+        pn = topo.pair_nodes
+        X = model.host["node_X"]
+        Q = len(pn) // 2
+        self.Q = Q
+        self.rebuild_interval = int(rebuild_interval)
+        self.mouth_radius = float(mouth_radius)
+        self.particle_floor = float(particle_floor)
+        nodes = np.stack([pn[0::2, 1], pn[1::2, 1], pn[1::2, 0], pn[0::2, 0]], 1).astype(np.int32)  # jA jB iB iA
+        length = np.linalg.norm(X[pn[1::2, 0]] - X[pn[0::2, 0]], axis=1)
+        self.cells = CrackCells()
+        self.cells.nodes = wp.array(nodes, dtype=wp.vec4i, device=d)
+        self.cells.length = wp.array(length, dtype=wp.float64, device=d)
+        self.host_length = length
+
+        def z(n, dtype=wp.float64):
+            return wp.zeros(max(1, n), dtype=dtype, device=d)
+
+        g = CrackGasState()
+        g.mass, g.energy, g.vol, g.pres, g.cs, g.gamma = z(Q), z(Q), z(Q), z(Q), z(Q), z(Q)
+        g.gap, g.force = z(Q, wp.vec2d), z(4 * Q, wp.vec2d)
+        g.wet = z(Q, wp.int32)
+        g.p_fixed = wp.full(max(1, Q), -1.0, dtype=wp.float64, device=d)
+        g.out, g.scale = z(Q), wp.ones(max(1, Q), dtype=wp.float64, device=d)
+        self.gas = g
+
+        P = mpm.material if mpm is not None else material
+        prm = CrackGasParams()
+        prm.rho0, prm.A, prm.B, prm.R1, prm.R2, prm.omega = P.rho0, P.A, P.B, P.R1, P.R2, P.omega
+        prm.p_max = float(p_max if p_max is not None else mpm.p_cj)
+        prm.mu, prm.w_min = float(viscosity), float(min_aperture)
+        prm.cell_fraction, prm.particle_fraction = float(cell_fraction), float(particle_fraction)
+        self.params = prm
+
+        pairs, ends, dx, vert = static_cell_links(pn, topo.node_vertex, X)
+        self.n_static = len(pairs)
+        self.static_pairs = wp.array(pairs.astype(np.int32), dtype=wp.vec2i, device=d)
+        self.static_ends = wp.array(ends.astype(np.int32), dtype=wp.vec2i, device=d)
+        self.static_dx = wp.array(dx, dtype=wp.float64, device=d)
+        surf = np.zeros(len(model.mesh.vertices), bool)
+        surf[np.asarray(model.mesh.boundary_edges, np.int64).ravel()] = True
+        cq, ce = np.nonzero(surf[vert]) if mpm is not None else (np.zeros(0, int), np.zeros(0, int))
+        self.n_cand = len(cq)
+        self.cand_cell = wp.array(cq.astype(np.int32), dtype=wp.int32, device=d)
+        self.cand_end = wp.array(ce.astype(np.int32), dtype=wp.int32, device=d)
+
+        cap = max(1, self.n_static + self.n_cand)
+        lk = CrackLinks()
+        lk.a, lk.b = z(cap, wp.int32), z(cap, wp.int32)
+        lk.ends, lk.dx, lk.dm, lk.h = z(cap, wp.vec2i), z(cap), z(cap), z(cap)
+        lk.count = wp.zeros(1, dtype=wp.int32, device=d)
+        self.links = lk
+        self.capacity = cap
+
+        pp = GasParticles()
+        if mpm is not None:
+            n = mpm.n
+            pp.x, pp.v, pp.mass, pp.vol, pp.vol0, pp.rho = mpm.x, mpm.v, mpm.mass, mpm.vol, mpm.vol0, mpm.rho
+            pp.ie, pp.pres, pp.q, pp.burn, pp.stress, pp.active = mpm.ie, mpm.p, mpm.q, mpm.burn, mpm.stress, mpm.active
+            pp.mass0 = wp.clone(mpm.mass)
+        else:
+            n = 0
+            pp.x, pp.v = z(1, wp.vec2d), z(1, wp.vec2d)
+            pp.mass, pp.mass0, pp.vol, pp.vol0, pp.rho, pp.ie, pp.pres, pp.q, pp.burn = (z(1) for _ in range(9))
+            pp.stress, pp.active = z(1, wp.mat22d), z(1, wp.int32)
+        self.n_particles = n
+        pp.out, pp.scale, pp.touched = z(n), wp.ones(max(1, n), dtype=wp.float64, device=d), z(n, wp.int32)
+        self.parts = pp
+
+        self.n_links = 0
+        self.n_mouths = 0
+        self._since = self.rebuild_interval
+        self._dt_prev = 0.0
+
+    # ------------------------------------------------------------------ per step
+    def rebuild(self, state) -> None:
+        """Wet-cell paths and mouths at the present state (host reads the two counts)."""
+        d = self.device
+        lk = self.links
+        lk.count.zero_()
+        if self.n_static:
+            wp.launch(collect_cell_links, dim=self.n_static,
+                      inputs=[self.static_pairs, self.static_ends, self.static_dx, self.gas.wet, lk], device=d)
+        self.n_links = int(lk.count.numpy()[0])
+        if self.n_cand:
+            wp.launch(collect_mouths, dim=self.n_cand,
+                      inputs=[self.cand_cell, self.cand_end, self.cells, self.gas.wet, state.x, self.parts,
+                              self.n_particles, wp.float64(self.mouth_radius), wp.float64(self.particle_floor * 1.01), lk],
+                      device=d)
+        total = int(lk.count.numpy()[0])
+        self.n_mouths = total - self.n_links
+        self._since = 0
+
+    def apply(self, state, dt: float) -> None:
+        """Stage between the particle–edge contact and P2G: cell pressures and face forces (added to state.f),
+        then this step's flow along the network and at the mouths."""
+        m, d = self.model, self.device
+        if self._since >= self.rebuild_interval:
+            self.rebuild(state)
+        self._since += 1
+        wp.launch(update_crack_cells, dim=self.Q,
+                  inputs=[self.cells, self.gas, self.params, state.pair_mode, state.x, state.v,
+                          wp.float64(self._dt_prev), wp.float64(dt), state.f], device=d)
+        self._dt_prev = dt
+        n = self.n_links + self.n_mouths
+        if n == 0:
+            return
+        wp.launch(crack_link_flux, dim=n, inputs=[self.links, self.gas, self.parts, self.params, wp.float64(dt)], device=d)
+        wp.launch(crack_cell_scale, dim=self.Q, inputs=[self.gas, self.params], device=d)
+        if self.n_mouths:
+            wp.launch(crack_particle_scale, dim=self.n_particles,
+                      inputs=[self.parts, self.params, wp.float64(self.particle_floor)], device=d)
+        wp.launch(crack_apply_flux, dim=n, inputs=[self.links, self.gas, self.parts], device=d)
+        if self.n_mouths:
+            wp.launch(crack_refresh_particles, dim=self.n_particles, inputs=[self.parts, self.params], device=d)
+
+    # ------------------------------------------------------------------ verification hooks
+    def set_cell_state(self, cells, mass, energy) -> None:
+        """Put gas mass [kg/m] and internal energy [J/m] in the given cells (tests, reservoirs)."""
+        for arr, val in ((self.gas.mass, mass), (self.gas.energy, energy)):
+            h = arr.numpy().copy()
+            h[np.asarray(cells)] = val
+            arr.assign(h)
+
+    def set_fixed_pressure(self, cells, p) -> None:
+        """Hold the given cells at pressure p [Pa] whatever their gas (the pressurised-crack verification)."""
+        h = self.gas.p_fixed.numpy().copy()
+        h[np.asarray(cells)] = p
+        self.gas.p_fixed.assign(h)
+
+    # ------------------------------------------------------------------ results
+    def energies(self) -> dict[str, float]:
+        """crack_gas: internal energy of the gas in the cracks [J/m]; crack_gas_mass [kg/m]."""
+        return {"crack_gas": float(self.gas.energy.numpy()[: self.Q].sum()),
+                "crack_gas_mass": float(self.gas.mass.numpy()[: self.Q].sum())}
+
+    def report(self) -> dict:
+        """Counts and extremes for summary.json → crack_gas."""
+        g = self.gas
+        mass, p, wet = g.mass.numpy()[: self.Q], g.pres.numpy()[: self.Q], g.wet.numpy()[: self.Q]
+        filled = mass > 0
+        gap = g.gap.numpy()[: self.Q]
+        return {
+            "wet_cells": int(wet.sum()), "gas_filled_cells": int(filled.sum()),
+            "mass": float(mass.sum()), "internal_energy": float(g.energy.numpy()[: self.Q].sum()),
+            "max_pressure": float(p.max()) if self.Q else 0.0,
+            "paths": self.n_links, "mouths": self.n_mouths,
+            "filled_length": float(self.host_length[filled].sum()),
+            "median_opening_filled": float(np.median(gap[filled].max(axis=1))) if filled.any() else 0.0,
+        }
