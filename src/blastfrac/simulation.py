@@ -60,6 +60,7 @@ class Simulation:
         self.gas = None
         self.coupler = None
         self.crack_gas = None
+        self.wall_load = None
         self.gas_report: dict = {}
         if scenario.explosive is not None:
             self._build_explosive()
@@ -108,6 +109,10 @@ class Simulation:
         self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval,
                                       force_cap=cp.force_cap, surface_forces=cp.surface_forces,
                                       pressure_preload=cp.pressure_preload)
+        if sc.geometry.boreholes:
+            from .analysis.wall_load import WallLoad
+
+            self.wall_load = WallLoad(self.model, sc.geometry.boreholes, self.device)
         if sc.crack_gas.enabled:
             from .coupling.crack_gas import CrackGas
 
@@ -139,6 +144,8 @@ class Simulation:
         self.cdem.forces(st, dt, self.time)                # springs + failure, CST, loads, block contact
         if couple:
             self.coupler.apply(st, dt)                     # particle–edge contact: gas f_ext_p, rock reactions
+            if self.wall_load is not None:
+                self.wall_load.accumulate(self.coupler.f_react, dt)
             if self.crack_gas is not None:
                 self.crack_gas.apply(st, dt)               # gas in cracks: face loads, flow, exchange at mouths
             self.gas.to_grid(dt)                           # P2G with the contact forces
@@ -236,6 +243,8 @@ class Simulation:
             if self.crack_gas is not None:
                 energy_cols += ["crack_gas"]
         energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"], unit="J/m")
+        self._wall_csv = (CsvHistory(self.out_dir / "borehole_pressure.csv", self.wall_load.names, unit="Pa")
+                          if self.wall_load is not None else None)
         wall0 = _time.perf_counter()
         try:
             self._run_loop(show, end, frame_dt, sample_dt, snap_times, series, gas_series, mon, frac, energy)
@@ -243,8 +252,9 @@ class Simulation:
             self._write_failed(err, _time.perf_counter() - wall0, (mon, frac, energy))
             raise
         wall = _time.perf_counter() - wall0
-        for h in (mon, frac, energy):
-            h.flush()
+        for h in (mon, frac, energy, self._wall_csv):
+            if h is not None:
+                h.flush()
         summary = self.summary(wall)
         write_summary(self.out_dir / "summary.json", summary)
         if sc.output.figures:
@@ -253,8 +263,9 @@ class Simulation:
 
     def _write_failed(self, err: SimulationError, wall: float, histories) -> None:
         """After a blow-up: the CSV histories up to the failure and summary.json with ``status = 'failed'``."""
-        for h in histories:
-            h.flush()
+        for h in (*histories, getattr(self, "_wall_csv", None)):
+            if h is not None:
+                h.flush()
         try:
             summary = self.summary(wall)
         except Exception as e2:  # noqa: BLE001 - the state is broken; keep what can be said
@@ -331,6 +342,11 @@ class Simulation:
         e = self.energies()
         err, rel = budget_error(e, self.initial_stored + self.initial_dissipated)
         energy.append(self.time, [*(e[k] for k in energy.columns[1:-1]), err])
+        if getattr(self, "_wall_csv", None) is not None:
+            t0 = self.wall_load._t_last
+            p = self.wall_load.sample(self.time)
+            if self.time > t0:
+                self._wall_csv.append(0.5 * (t0 + self.time), p)   # the mean over (t0, t]: at the interval's middle
         self._guard(e)
         self._check_budget(err, rel)
 

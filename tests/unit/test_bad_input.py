@@ -320,6 +320,11 @@ SET_CASES = [
      ["explosive.detonation_lines[0].delay", "finite"]),
     ("grid side of an unknown kind", CIRC, ["explosive.grid.boundaries={left='wall'}"],
      ["explosive.grid.boundaries"]),
+    ("crack gas without an explosive", BP, ["crack_gas.enabled=true"], ["crack_gas.enabled", "explosive"]),
+    ("crack gas viscosity negative", CIRC, ["crack_gas.viscosity=-1e-4"], ["crack_gas.viscosity"]),
+    ("crack gas aperture NaN", CIRC, ["crack_gas.min_aperture=nan"], ["crack_gas.min_aperture"]),
+    ("crack gas floor above 0.95", CIRC, ["crack_gas.particle_floor=1.2"], ["crack_gas.particle_floor"]),
+    ("crack gas unknown key", CIRC, ["crack_gas.enable=true"], ["crack_gas.enable"]),
 ]
 
 
