@@ -293,7 +293,7 @@ class Simulation:
                     next_sample += sample_dt
                 if self.time >= next_frame - 1e-15:
                     if series is not None:
-                        series.write(self.model, self.state, self.time)
+                        series.write(self.model, self.state, self.time, crack_gas=self.crack_gas)
                     if gas_series is not None:
                         gas_series.write(self.gas, self.time)
                     next_frame += frame_dt
@@ -313,7 +313,7 @@ class Simulation:
                 bar.update(task, completed=self.steps, total=self.steps)
             self._sample(mon, frac, energy)
             if series is not None:
-                series.write(self.model, self.state, self.time)
+                series.write(self.model, self.state, self.time, crack_gas=self.crack_gas)
             if gas_series is not None:
                 gas_series.write(self.gas, self.time)
             if k_snap < len(snap_times) or not self.snapshots:
@@ -531,8 +531,17 @@ class Simulation:
                                            title=f"{title}: displacement magnitude")
         if self.gas is not None:
             f = self.gas.particle_fields()
+            gas_seg = gas_p = None
+            if self.crack_gas is not None:
+                from .coupling.crack_gas import PRESSURISED
+
+                filled = np.flatnonzero(self.crack_gas.gas.pres.numpy()[: self.crack_gas.Q] >= PRESSURISED)
+                pn = self.model.topology.pair_nodes
+                gas_seg = np.stack([pn[2 * filled, 0], pn[2 * filled + 1, 0]], 1)
+                gas_p = self.crack_gas.gas.pres.numpy()[filled]
             figures.gas_particles(self.out_dir / "gas_pressure.png", f["position"], f["pressure"], x, seg, cmode,
-                                  title=f"{title}: gas pressure at t = {self.time * 1e6:.1f} µs")
+                                  title=f"{title}: gas pressure at t = {self.time * 1e6:.1f} µs",
+                                  gas_seg=gas_seg, gas_p=gas_p)
         cracks = self.crack_statistics() if cracks is None else cracks
         if cracks:
             figures.crack_profile(self.out_dir / "crack_profile.png", cracks,

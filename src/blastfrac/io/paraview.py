@@ -8,7 +8,8 @@ Both cell fields exist on both cell blocks, so that no reader sees a hole or a N
 is 0 on the triangles, ``stress`` is 0 on the crack lines (a crack carries no stress tensor; select
 the blocks with ``crack_mode == 0``). The stress is the full 3×3 plane-strain tensor [Pa], tension
 positive, with σ_zz = ν(σ_xx + σ_yy), ν = λ/(2(λ + μ)) the Poisson ratio of the blocks (ε_zz = 0).
-Every file is written atomically (io/atomic.py): a killed run leaves whole frames only.
+With gas in cracks, the crack lines also carry ``crack_gas_pressure`` [Pa] and ``crack_opening`` [m] (0 on the
+triangles and on cracks with one spring broken). Every file is written atomically (io/atomic.py): a killed run leaves whole frames only.
 """
 
 from __future__ import annotations
@@ -57,7 +58,9 @@ class ParaviewSeries:
         self.name = name
         self.frames: list[tuple[float, str]] = []
 
-    def write(self, model, state, t: float) -> None:
+    def write(self, model, state, t: float, crack_gas=None) -> None:
+        """One frame; with ``crack_gas`` (coupling.crack_gas.CrackGas) the crack lines also carry
+        ``crack_gas_pressure`` [Pa] and ``crack_opening`` (the larger end opening) [m], 0 on the triangles."""
         x = state.x.numpy()
         X = model.node_X.numpy()
         v = state.v.numpy()
@@ -69,10 +72,17 @@ class ParaviewSeries:
         n_e, n_c = len(tri), len(seg)
         stress = stress_tensor(sig, block_poisson_ratio(model))
         cell_data = {"stress": [stress], "crack_mode": [np.zeros(n_e, np.int32)]}
+        if crack_gas is not None:
+            cell_data["crack_gas_pressure"] = [np.zeros(n_e)]
+            cell_data["crack_opening"] = [np.zeros(n_e)]
         if n_c:
             cells.append(("line", seg))
             cell_data["stress"].append(np.zeros((n_c, 9)))
             cell_data["crack_mode"].append(cmode.astype(np.int32))
+            if crack_gas is not None:
+                broken = np.flatnonzero((state.pair_mode.numpy().reshape(-1, 2) > 0).any(axis=1))
+                cell_data["crack_gas_pressure"].append(crack_gas.gas.pres.numpy()[broken])
+                cell_data["crack_opening"].append(crack_gas.gas.gap.numpy()[broken].max(axis=1))
         u = x - X
         mesh = meshio.Mesh(
             pts, cells,

@@ -134,8 +134,10 @@ def displacement_snapshots(path: Path, snapshots: list[dict], title: str = "") -
 
 
 def gas_particles(path: Path, xp: np.ndarray, p: np.ndarray, x: np.ndarray, seg: np.ndarray, mode: np.ndarray,
-                  title: str = "", zoom: float | None = None) -> None:
-    """Gas particles coloured by pressure over the cracked rock (cracks red tensile / blue shear)."""
+                  title: str = "", zoom: float | None = None, gas_seg: np.ndarray | None = None,
+                  gas_p: np.ndarray | None = None) -> None:
+    """Gas particles coloured by pressure over the cracked rock (cracks red tensile / blue shear); with
+    ``gas_seg``/``gas_p`` the crack cells holding gas are drawn over them as thick lines in the same colours."""
     plt = _plt()
     from matplotlib.collections import LineCollection
     from matplotlib.colors import LogNorm
@@ -147,8 +149,17 @@ def gas_particles(path: Path, xp: np.ndarray, p: np.ndarray, x: np.ndarray, seg:
             ax.add_collection(LineCollection(x[s], colors=color, linewidths=0.6))
     if len(xp):
         pp = np.maximum(p, 1e5) / 1e6
-        sc = ax.scatter(xp[:, 0], xp[:, 1], c=pp, s=1.5, cmap="inferno", norm=LogNorm(vmin=max(pp.min(), 0.1),
+        lo_p = pp.min()
+        if gas_p is not None and len(gas_p):
+            lo_p = min(lo_p, float(np.maximum(gas_p, 1e5).min()) / 1e6)
+        sc = ax.scatter(xp[:, 0], xp[:, 1], c=pp, s=1.5, cmap="inferno", norm=LogNorm(vmin=max(lo_p, 0.1),
                                                                                    vmax=max(pp.max(), 1.0)))
+        if gas_seg is not None and len(gas_seg):
+            lc = LineCollection(x[gas_seg], cmap="inferno", norm=sc.norm, linewidths=2.0)
+            lc.set_array(np.maximum(gas_p, 1e5) / 1e6)
+            ax.add_collection(lc)
+            ax.plot([], [], color="tab:orange", lw=2.0, label="gas in cracks (thick lines, same colour scale)")
+            ax.legend(loc="upper right", fontsize=7)
         fig.colorbar(sc, ax=ax, label="gas pressure [MPa]")
         c = xp.mean(axis=0)
         span = zoom or max(4.0 * float(np.ptp(xp, axis=0).max()), 1e-3)
