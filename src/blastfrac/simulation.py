@@ -97,8 +97,8 @@ class Simulation:
         removed = [0]
 
         def keep_clear(x, vol):
-            x2, vol2, removed[0] = clear_from_rock(x, vol, self.model, clearance)
-            return x2, vol2
+            x2, vol2, removed[0], keep = clear_from_rock(x, vol, self.model, clearance, return_mask=True)
+            return x2, vol2, keep
 
         self.gas = MPMSolver(ex, device=self.device, particle_filter=keep_clear)
         if self.gas.n == 0:

@@ -64,8 +64,11 @@ def test_grid_from_scenario_several_charges_and_delayed_detonation_points():
     np.testing.assert_allclose(s.rho.numpy(), PETN.rho0)
     np.testing.assert_allclose(s.ie.numpy(), PETN.E0 * vol, rtol=1e-15)
     assert not s.v.numpy().any() and not s.stress.numpy().any() and not s.burn.numpy().any()
-    # lighting times: the earliest arrival over the points, each with its own delay
-    t_l = np.min(np.linalg.norm(x[:, None] - pts[None], axis=2) / D + delays[None], axis=1)
+    # lighting times: each charge from its own point, with its own delay (the detonation does not cross the 32 mm
+    # of rock between them: the old rule, the earliest arrival over all points, lit the square's left edge from
+    # the circle's point at 4.8 µs instead of 5.2 µs)
+    own = np.where(in_c, 0, 1)
+    t_l = np.linalg.norm(x - pts[own], axis=1) / D + delays[own]
     np.testing.assert_allclose(s.light_time.numpy(), t_l, rtol=1e-13)
     assert (t_l[in_s] > 4e-6 - 1e-15).all()  # the square is lit by its own delayed point, not by the first
     # run: at 3.5 us the circle burns, the square has not started; at 4.8 us the square burns around its point only

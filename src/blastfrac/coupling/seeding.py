@@ -49,14 +49,15 @@ def nearest_on_segments(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarr
 
 
 def clear_from_rock(x: np.ndarray, vol: np.ndarray, model, clearance: float,
-                    snap: float = 0.5) -> tuple[np.ndarray, np.ndarray, int]:
-    """(x, vol, removed): points at least ``clearance`` [m] from the rock's boundary edges and outside it.
+                    snap: float = 0.5, return_mask: bool = False):
+    """(x, vol, removed): points at least ``clearance`` [m] from the rock's boundary edges and outside it
+    (with ``return_mask``, also the mask of the input points kept).
 
     Points less than ``snap``·clearance short of it are moved away from the nearest edge instead of removed
     (up to three passes, for points near two edges); ``snap`` = 0 removes them all (the former rule).
     """
     if len(x) == 0:
-        return x, vol, 0
+        return (x, vol, 0, np.zeros(0, bool)) if return_mask else (x, vol, 0)
     x = np.array(x, dtype=float, copy=True)
     X = model.host["node_X"]
     slots = model.topology.boundary_slots
@@ -97,4 +98,6 @@ def clear_from_rock(x: np.ndarray, vol: np.ndarray, model, clearance: float,
     x, vol = x[keep], vol[keep]
     if len(vol):
         vol = vol * (total / float(vol.sum()))
+    if return_mask:
+        return x, vol, removed, keep
     return x, vol, removed

@@ -33,7 +33,8 @@ from blastfrac.mpm.apic import (
     affine_inertia_np,
     affine_kinetic_energy_np,
 )
-from blastfrac.mpm.burn import BURN_MODES, lighting_times, line_lighting_times
+from blastfrac.mpm.burn import BURN_MODES
+from blastfrac.mpm.initiation import body_lighting_times
 from blastfrac.mpm.grid import Grid, GridSpec
 from blastfrac.mpm.kernels_burn import update_burn
 from blastfrac.mpm.kernels_eos import update_jwl_state
@@ -107,8 +108,9 @@ class MPMSolver:
 
     # ------------------------------------------------------------------ construction
     def __init__(self, config, device: str = "cpu", particle_filter=None):
-        """Seed the charges of ``config`` (an ExplosiveConfig); ``particle_filter(x, vol) -> (x, vol)``, if given,
-        edits the seeded points before lighting times are computed (e.g. to clear them from the rock)."""
+        """Seed the charges of ``config`` (an ExplosiveConfig); ``particle_filter(x, vol) -> (x, vol[, keep])``, if
+        given, edits the seeded points before lighting times are computed (e.g. to clear them from the rock);
+        ``keep`` (a mask of the seeded points) keeps each point's charge, which the lighting times need."""
         params: JWLParams = config.jwl()
         opts = MPMOptions(
             shape=config.shape,
@@ -125,20 +127,20 @@ class MPMSolver:
             p_cj=config.burn.p_cj,
         )
         spec = grid_from_config(config)
-        x, vol, _ = seed_charges(config.charges, spec, opts.ppc, mode=config.seeding)
+        x, vol, cid = seed_charges(config.charges, spec, opts.ppc, mode=config.seeding)
         if particle_filter is not None:
-            x, vol = particle_filter(x, vol)
-        t_l = np.full(len(x), np.inf)
-        if config.detonation_points:
-            pts = np.array([d.position for d in config.detonation_points], float)
+            res = particle_filter(x, vol)
+            x, vol = res[0], res[1]
+            if len(res) > 2:
+                cid = cid[res[2]]
+        if config.detonation_points or config.detonation_lines:
+            pts = np.array([d.position for d in config.detonation_points], float).reshape(-1, 2)
             delays = np.array([d.delay for d in config.detonation_points], float)
-            t_l = lighting_times(x, pts, delays, params.D)
-        elif not config.detonation_lines:
+        else:                                   # each charge at its own centroid
             pts = np.array([charge_area_centroid(c)[1] for c in config.charges])
-            t_l = lighting_times(x, pts, np.zeros(len(pts)), params.D)
-        for dl in config.detonation_lines:
-            vel = dl.velocity if dl.velocity is not None else params.D
-            t_l = np.minimum(t_l, line_lighting_times(x, dl.start, dl.end, dl.delay, vel, params.D))
+            delays = np.zeros(len(pts))
+        t_l = body_lighting_times(x, vol, cid, config.charges, pts, delays, config.detonation_lines, params.D)
+        self.charge_id = np.asarray(cid, np.int32)      # charge of each particle (host) [-]
         self.config = config
         self._build(x, vol, spec, params, opts, device, light_time=t_l)
         self.walls = boundary_walls(config, spec)

@@ -198,11 +198,13 @@ class ExplosiveConfig(_Model):
     constants: JWLConstants | None = Field(default=None, description="custom JWL set (instead of name)")
     charges: list[Charge] = Field(min_length=1, description="charge regions filled with material points")
     detonation_points: list[DetonationPoint] = Field(
-        default_factory=list, description="initiation points; default: the centroid of each charge, no delay"
+        default_factory=list, description="initiation points; each lights the charge it lies in (and the charges "
+        "touching it), never through rock; default: the centroid of each charge, no delay"
     )
     detonation_lines: list[DetonationLine] = Field(
         default_factory=list, description="line initiators (detonating cords), lit together with detonation_points: "
-        "t_l is the earliest over both; with neither, each charge lights at its centroid"
+        "t_l is the earliest over both, each lighting only the charges it touches; with neither, each charge "
+        "lights at its centroid"
     )
     grid: GridConfig = Field(description="background grid")
     seeding: Literal["conformal", "lattice"] = Field(
