@@ -29,6 +29,53 @@ from .scenario.schema import Scenario
 
 
 _BUDGET_MIN_STEPS = 50      # energy-budget samples before this step are not checked against output.budget_warning
+CHECKPOINT_NAME = "checkpoint.npz"
+
+
+class RunInterrupted(RuntimeError):
+    """SIGINT or SIGTERM stopped the run after a whole step; checkpoint, CSVs and summary.json are written.
+    ``signum`` is the signal, ``exit_code`` 128 + signum (130, 143)."""
+
+    def __init__(self, signum: int, out_dir: Path):
+        super().__init__(f"interrupted by signal {signum}; the run can continue with "
+                         f"blastfrac run --restart {out_dir}")
+        self.signum, self.exit_code, self.out_dir = signum, 128 + signum, out_dir
+
+
+def _install_stop_handlers(sim) -> dict:
+    """SIGINT/SIGTERM set ``sim._stop_signal``; the loop stops after the current step (main thread only)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+
+    def handler(signum, frame):
+        if sim._stop_signal is not None:           # a second signal: stop at once
+            raise KeyboardInterrupt
+        sim._stop_signal = signum
+
+    old = {}
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        old[sig] = signal.signal(sig, handler)
+    return old
+
+
+def _restore_handlers(old: dict) -> None:
+    import signal
+
+    for sig, h in old.items():
+        signal.signal(sig, h)
+
+
+def _restart_key(resolved: dict) -> str:
+    """The resolved scenario without what a restart may change (end time, step limit, progress, device, output)."""
+    import json
+
+    d = {k: v for k, v in resolved.items() if k != "output"}
+    d["simulation"] = {k: v for k, v in d.get("simulation", {}).items()
+                       if k not in ("end_time", "max_steps", "progress", "device")}
+    return json.dumps(d, sort_keys=True, default=str)
 
 
 class SimulationError(RuntimeError):
@@ -221,45 +268,131 @@ class Simulation:
                 for b in self.scenario.geometry.boreholes]
 
     # ------------------------------------------------------------------ run loop
-    def run(self, progress: bool | None = None) -> dict:
+    def run(self, progress: bool | None = None, restart: str | Path | None = None) -> dict:
+        """Run to ``simulation.end_time`` (or ``max_steps``) and write the results; returns the summary.
+
+        ``restart``: a checkpoint file (io/checkpoint.py) of this scenario to continue from. SIGINT/SIGTERM finish
+        the current step, write a checkpoint, every CSV and summary.json (status 'interrupted') and raise
+        :class:`RunInterrupted`.
+        """
         sc = self.scenario
         self.out_dir.mkdir(parents=True, exist_ok=True)
         write_resolved(sc, self.out_dir / "resolved.toml")
         show = sc.simulation.progress if progress is None else progress
+        self._open_outputs()
+        if restart is not None:
+            self._load_checkpoint(Path(restart))
+        wall0 = _time.perf_counter() - self._wall_before
+        self._stop_signal = None
+        handlers = _install_stop_handlers(self)
+        try:
+            self._run_loop(show)
+        except SimulationError as err:
+            self._write_failed(err, _time.perf_counter() - wall0, (self._mon, self._frac, self._energy))
+            raise
+        finally:
+            _restore_handlers(handlers)
+        wall = _time.perf_counter() - wall0
+        if self._stop_signal is not None:
+            self.write_checkpoint(wall)          # before the closing sample: a restart continues the schedule
+            self._sample()
+            self._flush_histories()
+            summary = self.summary(wall)
+            summary["status"] = "interrupted"
+            summary["checkpoint"] = str(self.out_dir / CHECKPOINT_NAME)
+            write_summary(self.out_dir / "summary.json", summary)
+            raise RunInterrupted(self._stop_signal, self.out_dir)
+        self._flush_histories()
+        summary = self.summary(wall)
+        write_summary(self.out_dir / "summary.json", summary)
+        if sc.output.figures:
+            self.write_figures(self._mon, self._frac, self._energy, cracks=summary["cracks"])
+        return summary
+
+    def _open_outputs(self) -> None:
+        """The histories, ParaView series and the run loop's schedule (what a checkpoint saves besides the state)."""
+        sc = self.scenario
         end = sc.simulation.end_time
-        frame_dt = sc.output.interval or end / 20
-        sample_dt = sc.output.monitor_interval or end / 200
-        snap_times = list(sc.output.snapshot_times) or [end * k / 4 for k in (1, 2, 3, 4)]
+        self._frame_dt = sc.output.interval or end / 20
+        self._sample_dt = sc.output.monitor_interval or end / 200
+        self._snap_times = list(sc.output.snapshot_times) or [end * k / 4 for k in (1, 2, 3, 4)]
+        self._checkpoint_dt = sc.output.checkpoint_interval
         self.snapshots: list[dict] = []
-        series = ParaviewSeries(self.out_dir) if sc.output.paraview else None
-        gas_series = GasSeries(self.out_dir) if sc.output.paraview and self.gas is not None else None
-        mon = CsvHistory(self.out_dir / "monitors.csv", self.monitors.columns, unit=monitor_unit)
-        frac = CsvHistory(self.out_dir / "fracture_degree.csv", list(self.fracture.sample(self.state.pair_mode.numpy())),
-                          unit="-")
+        self._series = ParaviewSeries(self.out_dir) if sc.output.paraview else None
+        self._gas_series = GasSeries(self.out_dir) if sc.output.paraview and self.gas is not None else None
+        self._mon = CsvHistory(self.out_dir / "monitors.csv", self.monitors.columns, unit=monitor_unit)
+        self._frac = CsvHistory(self.out_dir / "fracture_degree.csv",
+                                list(self.fracture.sample(self.state.pair_mode.numpy())), unit="-")
         energy_cols = ["kinetic", "strain", "springs", "fracture", "friction", "viscous_absorbed", "damping",
                        "external_work"]
         if self.gas is not None:
             energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_energy"]
             if self.crack_gas is not None:
                 energy_cols += ["crack_gas"]
-        energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"], unit="J/m")
+        self._energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"], unit="J/m")
         self._wall_csv = (CsvHistory(self.out_dir / "borehole_pressure.csv", self.wall_load.names, unit="Pa")
                           if self.wall_load is not None else None)
-        wall0 = _time.perf_counter()
-        try:
-            self._run_loop(show, end, frame_dt, sample_dt, snap_times, series, gas_series, mon, frac, energy)
-        except SimulationError as err:
-            self._write_failed(err, _time.perf_counter() - wall0, (mon, frac, energy))
-            raise
-        wall = _time.perf_counter() - wall0
-        for h in (mon, frac, energy, self._wall_csv):
+        self._next_frame = self._next_sample = 0.0
+        self._k_snap = 0
+        self._next_checkpoint = self._checkpoint_dt if self._checkpoint_dt else math.inf
+        self._insitu_done = False
+        self._wall_before = 0.0
+
+    def _histories(self) -> dict:
+        return {"monitors": self._mon, "fracture_degree": self._frac, "energy": self._energy,
+                "borehole_pressure": self._wall_csv}
+
+    def _flush_histories(self) -> None:
+        for h in self._histories().values():
             if h is not None:
                 h.flush()
-        summary = self.summary(wall)
-        write_summary(self.out_dir / "summary.json", summary)
-        if sc.output.figures:
-            self.write_figures(mon, frac, energy, cracks=summary["cracks"])
-        return summary
+
+    # ------------------------------------------------------------------ checkpoint and restart
+    def write_checkpoint(self, wall: float | None = None) -> Path:
+        """The full state of the run now, atomically, as ``checkpoint.npz`` in the output directory."""
+        from .io import checkpoint as ckpt
+        from .scenario.load import resolved_dict
+
+        run = {"next_frame": self._next_frame, "next_sample": self._next_sample, "k_snap": self._k_snap,
+               "next_checkpoint": self._next_checkpoint, "insitu_done": self._insitu_done,
+               "wall": wall if wall is not None else self._wall_before, "warnings": list(self.warnings),
+               "budget_warned": self._budget_warned, "insitu_report": self.insitu_report,
+               "rows": {k: h.rows for k, h in self._histories().items() if h is not None},
+               "frames": {"rock": self._series.frames if self._series else [],
+                          "gas": self._gas_series.frames if self._gas_series else []},
+               "snapshots": [{k: v for k, v in s.items() if not isinstance(v, np.ndarray)} for s in self.snapshots]}
+        extra = {f"snap{i}/{k}": v for i, s in enumerate(self.snapshots) for k, v in s.items() if isinstance(v, np.ndarray)}
+        path = self.out_dir / CHECKPOINT_NAME
+        ckpt.write(path, self, run, _restart_key(resolved_dict(self.scenario)), __version__, extra=extra)
+        return path
+
+    def _load_checkpoint(self, path: Path) -> None:
+        from .io import checkpoint as ckpt
+        from .scenario.load import resolved_dict
+
+        arrays, meta = ckpt.read(path)
+        if meta.get("scenario_hash") != ckpt.scenario_hash(_restart_key(resolved_dict(self.scenario))):
+            raise ValueError(f"--restart {path}: the checkpoint was made from another scenario (only "
+                             "simulation.end_time, max_steps, progress, device and [output] may change)")
+        extra = {k: arrays.pop(k) for k in list(arrays) if k.startswith("snap")}
+        ckpt.restore(self, arrays, meta["scalars"])
+        run = meta["run"]
+        self._next_frame, self._next_sample, self._k_snap = run["next_frame"], run["next_sample"], run["k_snap"]
+        self._next_checkpoint = (self.time + self._checkpoint_dt) if self._checkpoint_dt else math.inf
+        self._insitu_done, self._wall_before = run["insitu_done"], run["wall"]
+        self.warnings, self._budget_warned, self.insitu_report = run["warnings"], run["budget_warned"], run["insitu_report"]
+        for k, h in self._histories().items():
+            if h is not None:
+                h.rows = [list(r) for r in run["rows"].get(k, [])]
+        if self._series is not None:
+            self._series.frames = [tuple(f) for f in run["frames"]["rock"]]
+        if self._gas_series is not None:
+            self._gas_series.frames = [tuple(f) for f in run["frames"]["gas"]]
+        self.snapshots = []
+        for i, s in enumerate(run["snapshots"]):
+            d = dict(s)
+            d.update({k.split("/", 1)[1]: v for k, v in extra.items() if k.startswith(f"snap{i}/")})
+            self.snapshots.append(d)
 
     def _write_failed(self, err: SimulationError, wall: float, histories) -> None:
         """After a blow-up: the CSV histories up to the failure and summary.json with ``status = 'failed'``."""
@@ -277,30 +410,38 @@ class Simulation:
         summary["failure"] = err.details
         write_summary(self.out_dir / "summary.json", summary)
 
-    def _run_loop(self, show, end, frame_dt, sample_dt, snap_times, series, gas_series, mon, frac, energy) -> None:
+    def _run_loop(self, show) -> None:
         sc = self.scenario
+        end = sc.simulation.end_time
+        series, gas_series = self._series, self._gas_series
         with _progress(show) as bar:
-            if sc.insitu.active:
+            if sc.insitu.active and not self._insitu_done:
                 self.relax_insitu(bar)
-            n_est = math.ceil(end / self.dt)
+                self._insitu_done = True
+            n_est = self.steps + math.ceil(max(end - self.time, 0.0) / self.dt)
             if self.max_steps is not None:
                 n_est = min(n_est, self.max_steps)
-            task = bar.add_task("dynamic stage", total=n_est) if bar else None
-            next_frame, next_sample, k_snap = 0.0, 0.0, 0
+            task = bar.add_task("dynamic stage", total=n_est, completed=self.steps) if bar else None
             while self.time < end * (1 - 1e-12) and (self.max_steps is None or self.steps < self.max_steps):
-                if self.time >= next_sample - 1e-15:
-                    self._sample(mon, frac, energy)
-                    next_sample += sample_dt
-                if self.time >= next_frame - 1e-15:
+                if self.time >= self._next_sample - 1e-15:
+                    self._sample()
+                    self._next_sample += self._sample_dt
+                if self.time >= self._next_frame - 1e-15:
                     if series is not None:
                         series.write(self.model, self.state, self.time, crack_gas=self.crack_gas)
                     if gas_series is not None:
                         gas_series.write(self.gas, self.time)
-                    next_frame += frame_dt
-                if k_snap < len(snap_times) and self.time >= snap_times[k_snap] - 0.5 * self.dt:
+                    self._next_frame += self._frame_dt
+                if self._k_snap < len(self._snap_times) and self.time >= self._snap_times[self._k_snap] - 0.5 * self.dt:
                     self._snapshot()
-                    k_snap += 1
+                    self._k_snap += 1
                 self.step()
+                if self.time >= self._next_checkpoint - 1e-15:
+                    self.write_checkpoint()
+                    self._flush_histories()
+                    self._next_checkpoint += self._checkpoint_dt
+                if self._stop_signal is not None:
+                    return
                 if task is not None and self.steps % 50 == 0:
                     if self.gas is not None:   # the step may change with the gas speed: re-estimate the total
                         n_est = self.steps + math.ceil(max(end - self.time, 0.0) / self.dt)
@@ -311,12 +452,14 @@ class Simulation:
             wp.synchronize()
             if task is not None:
                 bar.update(task, completed=self.steps, total=self.steps)
-            self._sample(mon, frac, energy)
+            if self._checkpoint_dt:                # the end state too, before the closing sample: a restart with a
+                self.write_checkpoint()            # later end_time continues from here
+            self._sample()
             if series is not None:
                 series.write(self.model, self.state, self.time, crack_gas=self.crack_gas)
             if gas_series is not None:
                 gas_series.write(self.gas, self.time)
-            if k_snap < len(snap_times) or not self.snapshots:
+            if self._k_snap < len(self._snap_times) or not self.snapshots:
                 self._snapshot()
 
     def energies(self) -> dict[str, float]:
@@ -333,7 +476,8 @@ class Simulation:
     def _gas_pressure(self, pts: np.ndarray) -> np.ndarray:
         return self.gas.pressure_at(pts)
 
-    def _sample(self, mon: CsvHistory, frac: CsvHistory, energy: CsvHistory) -> None:
+    def _sample(self) -> None:
+        mon, frac, energy = self._mon, self._frac, self._energy
         st = self.state
         x, v, sig = st.x.numpy(), st.v.numpy(), st.sigma.numpy()
         gp = self._gas_pressure if self.gas is not None else None

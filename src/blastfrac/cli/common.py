@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 
-def add_scenario_args(p) -> None:
-    p.add_argument("scenario", help="scenario TOML file")
+def add_scenario_args(p, optional: bool = False) -> None:
+    if optional:
+        p.add_argument("scenario", nargs="?", default=None, help="scenario TOML file")
+    else:
+        p.add_argument("scenario", help="scenario TOML file")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override a scenario value (TOML syntax), may be repeated")
     p.add_argument("--device", choices=None, default=None, help="Warp device: cpu, cuda, cuda:N (default: scenario)")

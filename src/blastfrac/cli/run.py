@@ -9,10 +9,14 @@ from .common import add_force_arg, add_scenario_args, check_output_dir, load, re
 
 def add_parser(sub) -> None:
     p = sub.add_parser("run", help="run a scenario", description="Run a scenario and write results to its output directory.")
-    add_scenario_args(p)
+    add_scenario_args(p, optional=True)
     p.add_argument("--out", default=None, help="output directory (default: output.directory of the scenario)")
     p.add_argument("--max-steps", type=int, default=None, help="stop after N steps of the dynamic stage")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--restart", default=None, metavar="DIR",
+                   help="continue the run whose output directory is DIR from its checkpoint.npz (the scenario "
+                        "defaults to DIR/resolved.toml; only simulation.end_time, max_steps, progress, device and "
+                        "[output] may differ). Results are bit-identical to a run that went through.")
     add_force_arg(p)
     p.set_defaults(func=run)
 
@@ -20,8 +24,24 @@ def add_parser(sub) -> None:
 def run(args) -> int:
     from ..scenario import ScenarioError
     from ..scenario.sizes import check_sizes
-    from ..simulation import Simulation, SimulationError
+    from pathlib import Path
 
+    from ..simulation import CHECKPOINT_NAME, RunInterrupted, Simulation, SimulationError
+
+    ckpt = None
+    if args.restart is not None:
+        d = Path(args.restart)
+        ckpt = d / CHECKPOINT_NAME
+        if not ckpt.is_file():
+            raise ScenarioError(f"--restart {args.restart!r}: no {CHECKPOINT_NAME} there (output.checkpoint_interval "
+                                "writes one, and so does Ctrl-C)")
+        if args.scenario is None:
+            args.scenario = str(d / "resolved.toml")
+        if args.out and Path(args.out).resolve() != d.resolve():
+            raise ScenarioError("--restart continues in its own directory; leave out --out")
+        args.out = str(d)
+    elif args.scenario is None:
+        raise ScenarioError("give a scenario file (or --restart DIR)")
     sc = load(args)
     if args.out:
         sc.output.directory = args.out
@@ -37,10 +57,15 @@ def run(args) -> int:
     except ValueError as e:
         raise ScenarioError(str(e)) from None
     try:
-        s = sim.run(progress=False if args.no_progress else None)
+        s = sim.run(progress=False if args.no_progress else None, restart=ckpt)
     except SimulationError as e:
         print(f"error: {e}", file=sys.stderr)   # summary.json (status 'failed') and the CSVs are written
         return 1
+    except RunInterrupted as e:
+        print(f"{e} (t = {sim.time * 1e6:.2f} µs, step {sim.steps})", file=sys.stderr)
+        return e.exit_code
+    except ValueError as e:                     # a checkpoint of another scenario
+        raise ScenarioError(str(e)) from None
     b = s["broken_springs"]
     print(f"{s['steps']} steps, t = {s['simulated_time'] * 1e6:.2f} µs, wall {s['wall_time_s']:.1f} s; "
           f"broken springs {b['total']} (tensile {b['tensile']}, shear {b['shear']}) of {s['counts']['springs']}; "

@@ -65,6 +65,11 @@ class OutputConfig(_Strict):
         description="Times [s] at which displacement (and gas) snapshots are kept for the Fig. 4-style panel; "
         "default: four equally spaced times.",
     )
+    checkpoint_interval: float | None = Field(
+        None, gt=0, description="Simulated time between checkpoints [s] (checkpoint.npz in the output directory, "
+        "written atomically; the last one is kept); default none. SIGINT/SIGTERM always write one. Continue with "
+        "`blastfrac run --restart DIR` (bit-identical to a run that went through, io/checkpoint.py).",
+    )
     budget_warning: float = Field(
         0.05, gt=0, le=1,
         description="Relative energy-budget error (|budget_error_relative|) above which the run warns on stderr "
@@ -84,6 +89,49 @@ class OutputConfig(_Strict):
 
 
 # --------------------------------------------------------------------------- rock
+HeterogeneityField = Literal["tensile_strength", "cohesion", "stiffness"]
+
+
+class HeterogeneityConfig(_Strict):
+    """Weibull scatter of the spring properties from interface to interface (model/heterogeneity.py,
+    docs/heterogeneity.md); seeded by simulation.seed."""
+
+    weibull_modulus: float | None = Field(
+        None, gt=0, description="Weibull modulus m of the per-interface factors [-], > 0; None (default) = "
+        "homogeneous rock. The factors have mean 1 (the rock's values are the means) and coefficient of "
+        "variation √(Γ(1+2/m) − Γ(1+1/m)²)/Γ(1+1/m): 0.52 at m = 2, 0.23 at m = 5, 0.12 at m = 10.",
+    )
+    fields: list[HeterogeneityField] = Field(
+        default_factory=lambda: ["tensile_strength", "cohesion"], min_length=1,
+        description="Properties that scatter: 'tensile_strength' (T), 'cohesion' (c), 'stiffness' (kn and ks "
+        "by the same factor; needs weibull_modulus > 1). Both springs of an interface get the same factor.",
+    )
+    correlated: bool = Field(
+        True, description="One factor per interface shared by every listed property (a weak interface is weak in "
+        "tension and shear alike); false: an independent draw per property.",
+    )
+
+    @field_validator("fields")
+    @classmethod
+    def _distinct_fields(cls, v: list[str]) -> list[str]:
+        for j, f in enumerate(v):
+            if f in v[:j]:
+                raise ValueError(f"'{f}' is listed twice; each property once")
+        return v
+
+    @model_validator(mode="after")
+    def _stiffness_modulus(self) -> "HeterogeneityConfig":
+        m = self.weibull_modulus
+        if m is not None and "stiffness" in self.fields and m <= 1.0:
+            raise ValueError(f"weibull_modulus: {m} is too small for 'stiffness' in fields: the spring compliance "
+                             "1/k of a Weibull stiffness has no finite mean for m <= 1 (give m > 1)")
+        return self
+
+    @property
+    def active(self) -> bool:
+        return self.weibull_modulus is not None
+
+
 class RockConfig(_Strict):
     """Rock: elastic blocks (CST) and the breakable interface springs between them."""
 
@@ -144,6 +192,11 @@ class RockConfig(_Strict):
     bulk_viscosity_quadratic: float = Field(
         0.0, ge=0, le=4, description="Quadratic (von Neumann–Richtmyer) artificial bulk viscosity coefficient "
         "C_q of the blocks [-]; see bulk_viscosity_linear.",
+    )
+    heterogeneity: HeterogeneityConfig = Field(
+        default_factory=HeterogeneityConfig,
+        description="Per-interface Weibull scatter of T, c and the spring stiffness around the values above "
+        "(which are the means); off unless heterogeneity.weibull_modulus is given (docs/heterogeneity.md).",
     )
 
     @model_validator(mode="before")
