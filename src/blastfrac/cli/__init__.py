@@ -1,4 +1,4 @@
-"""Command line: ``blastfrac run|check|bench|explosive``.
+"""Command line: ``blastfrac run|check|bench|explosive|calibrate|sweep``.
 
 User errors (bad scenario, missing file) print one message and exit with code 2, no traceback.
 """
@@ -12,7 +12,7 @@ import sys
 EXIT_USER_ERROR = 2
 
 # subcommand modules, each exposing add_parser(subparsers) and run(args) -> int
-_COMMANDS = ("run", "check", "bench", "explosive", "calibrate")
+_COMMANDS = ("run", "check", "bench", "explosive", "calibrate", "sweep")
 
 
 def build_parser() -> argparse.ArgumentParser:
