@@ -42,6 +42,27 @@ class RunInterrupted(RuntimeError):
         self.signum, self.exit_code, self.out_dir = signum, 128 + signum, out_dir
 
 
+#: files a run writes that a later run into the same directory must not leave behind (stale frames)
+_RUN_OUTPUTS = ("rock_[0-9][0-9][0-9][0-9].vtu", "gas_[0-9][0-9][0-9][0-9].vtu", "rock.pvd", "gas.pvd",
+                CHECKPOINT_NAME, "summary.json", "monitors.csv", "energy.csv", "fracture_degree.csv",
+                "borehole_pressure.csv")
+
+
+def clear_previous_outputs(out_dir: Path) -> int:
+    """Remove the frames, histories, summary and checkpoint of an earlier run in ``out_dir`` (only blastfrac's own
+    file names; anything else stays); returns the number of files removed, and says so on stderr."""
+    n = 0
+    for pattern in _RUN_OUTPUTS:
+        for f in Path(out_dir).glob(pattern):
+            if f.is_file():
+                f.unlink()
+                n += 1
+    if n:
+        print(f"note: removed {n} output files of an earlier run in {out_dir} (frames, histories, summary)",
+              file=sys.stderr, flush=True)
+    return n
+
+
 def _install_stop_handlers(sim) -> dict:
     """SIGINT/SIGTERM set ``sim._stop_signal``; the loop stops after the current step (main thread only)."""
     import signal
@@ -221,8 +242,9 @@ class Simulation:
         # at least two P-wave transits of the domain before the criterion is trusted
         span = float(np.ptp(self.model.host["node_X"], axis=0).max())
         min_steps = int(2 * span / self.scenario.rock.p_wave_speed / self.dt) + 1
-        task = progress.add_task("in-situ relaxation", total=ins.max_steps) if progress else None
-        while not converged and steps < ins.max_steps:
+        limit = ins.max_steps if self.max_steps is None else min(ins.max_steps, self.max_steps)   # --max-steps too
+        task = progress.add_task("in-situ relaxation", total=limit) if progress else None
+        while not converged and steps < limit:
             self.step(gas=False)
             steps += 1
             if steps % 200 == 0:
@@ -233,7 +255,14 @@ class Simulation:
                 if task is not None:
                     progress.update(task, completed=steps, description=f"in-situ relaxation (KE/U {ratio:.1e})")
         if task is not None:
-            progress.update(task, completed=ins.max_steps)
+            progress.update(task, completed=limit)
+        if not converged:
+            msg = (f"in-situ stage did not converge: KE/U = {ratio:.2e} after {steps} steps (insitu.tolerance "
+                   f"{ins.tolerance:g}, limit {limit}" + (" from --max-steps" if limit < ins.max_steps else
+                                                         " = insitu.max_steps") + "); the blast starts from a "
+                   "state that is still moving: raise insitu.max_steps, or check insitu.damping")
+            self.warnings.append(msg)
+            print(f"warning: {msg}", file=sys.stderr, flush=True)
         self.model.breakable, self.alpha = breakable, saved_alpha
         t_relax = self.time
         tb = self.state.pair_tbreak.numpy().copy()
@@ -277,6 +306,8 @@ class Simulation:
         """
         sc = self.scenario
         self.out_dir.mkdir(parents=True, exist_ok=True)
+        if restart is None:
+            self.cleared = clear_previous_outputs(self.out_dir)
         write_resolved(sc, self.out_dir / "resolved.toml")
         show = sc.simulation.progress if progress is None else progress
         self._open_outputs()

@@ -231,3 +231,31 @@ def test_blow_up_names_position_and_writes_outputs(tmp_path, monkeypatch, capsys
 def test_simulation_error_carries_details():
     e = SimulationError("boom", {"step": 3})
     assert str(e) == "boom" and e.details == {"step": 3}
+
+
+def test_a_new_run_clears_the_frames_of_an_earlier_one(tmp_path, capsys):
+    """Run twice into one directory, the second with fewer frames: no stale rock_NNNN.vtu of the first stays in
+    it (ParaView would read them as part of the series); files that are not blastfrac's own are left alone."""
+    d = _scenario(tmp_path)
+    Simulation(scenario_from_dict(d)).run()
+    out = tmp_path / "out"
+    first = sorted(p.name for p in out.glob("rock_*.vtu"))
+    (out / "notes.txt").write_text("mine")
+    d["output"]["interval"] = 1e-6
+    Simulation(scenario_from_dict(d)).run()
+    second = sorted(p.name for p in out.glob("rock_*.vtu"))
+    assert len(second) < len(first)
+    frames = [l for l in (out / "rock.pvd").read_text().splitlines() if "file=" in l]
+    assert len(frames) == len(second)
+    assert (out / "notes.txt").read_text() == "mine"
+    assert "removed" in capsys.readouterr().err
+
+
+def test_max_steps_bounds_the_insitu_stage_and_non_convergence_warns(tmp_path, capsys):
+    d = _scenario(tmp_path, insitu={"syy": -10e6, "max_steps": 100_000, "tolerance": 1e-12})
+    d.pop("borehole_pressure")
+    sim = Simulation(scenario_from_dict(d), max_steps=400)
+    s = sim.run()
+    assert s["insitu_stage"]["steps"] == 400 and not s["insitu_stage"]["converged"]
+    assert any("did not converge" in w for w in s["warnings"])
+    assert "did not converge" in capsys.readouterr().err

@@ -118,3 +118,17 @@ def test_topology_counts_follow_euler():
     # each spring appears once as i and once as j in the node gather table
     s = topo.node_pair_sign
     assert (s == -1).sum() == len(pn) and (s == 1).sum() == len(pn)
+
+
+def test_check_predicts_steps_from_the_contact_and_mpm_limits(capsys):
+    """`check` takes the step from every limit: a contact stiffness of 1e30 Pa gives a contact step of
+    2/ω = 2√(m/k)·(...) ~ 1e-17 s, and check predicts its ~1e12 steps and warns (it used to print the rock's)."""
+    import re
+
+    root = Path(__file__).resolve().parents[2]
+    rc = main(["check", str(root / "examples/circular_rock/demo.toml"), "--set", "coupling.contact_stiffness=1e30"])
+    out = capsys.readouterr()
+    assert rc == 0
+    steps = int(re.search(r"steps to end time\s+([\d,]+)", out.out).group(1).replace(",", ""))
+    assert steps > 1e11 and "step limited by              contact" in out.out
+    assert "warning" in out.err and "contact_stiffness" in out.err
