@@ -19,6 +19,10 @@ them as particles. This stage carries the gas there as a network of *cells*, one
   side exactly as they reach the other. A particle that gives (or takes) gas keeps its volume: its density
   and pressure fall as in an isentropic expansion, and its reference volume V0 = m/ρ0 follows its mass.
 
+* **Wide cracks belong to the particles.** A cell open wider than a material point (the spacing h/ppc) at both
+  ends hands its gas (mass, energy and volume) to the nearest burnt particle and leaves the network for good:
+  particles enter such a crack and load it by contact, and the gas is not counted twice.
+
 The network (wet-cell paths and mouths) is rebuilt every ``rebuild_interval`` steps; a cell that breaks in
 between is loaded from the next rebuild on. Units SI, per unit thickness.
 """
@@ -30,7 +34,8 @@ import warp as wp
 
 from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasParticles,
                                 collect_cell_links, collect_mouths, crack_apply_flux, crack_cell_scale,
-                                crack_link_flux, crack_particle_scale, crack_refresh_particles, update_crack_cells)
+                                crack_link_flux, crack_particle_scale, crack_refresh_particles, release_wide_cells,
+                                update_crack_cells)
 
 
 def static_cell_links(pair_nodes: np.ndarray, node_vertex: np.ndarray, X: np.ndarray):
@@ -154,6 +159,10 @@ class CrackGas:
         pp.out, pp.scale, pp.touched = z(n), wp.ones(max(1, n), dtype=wp.float64, device=d), z(n, wp.int32)
         self.parts = pp
 
+        # a cell open wider than this at both ends hands its gas to the MPM [m] (the particle spacing h/ppc)
+        self.particle_size = float(mpm.spec.h / mpm.opts.ppc) if mpm is not None else 0.0
+        self._released = wp.zeros(1, dtype=wp.int32, device=d)
+        self.released_cells = 0
         self.n_links = 0
         self.n_mouths = 0
         self._since = self.rebuild_interval
@@ -161,9 +170,20 @@ class CrackGas:
 
     # ------------------------------------------------------------------ per step
     def rebuild(self, state) -> None:
-        """Wet-cell paths and mouths at the present state (host reads the two counts)."""
+        """Wide cells handed to the MPM, then the wet-cell paths and mouths at the present state (host reads the
+        counts)."""
         d = self.device
         lk = self.links
+        if self.n_particles and self.particle_size > 0.0:
+            self._released.zero_()
+            wp.launch(release_wide_cells, dim=self.Q,
+                      inputs=[self.cells, self.gas, self.parts, self.n_particles, state.x, state.v,
+                              wp.float64(self.particle_size), wp.float64(self.mouth_radius + self.particle_size),
+                              wp.float64(self._dt_prev), self._released], device=d)
+            n_rel = int(self._released.numpy()[0])
+            self.released_cells += n_rel
+            if n_rel:
+                wp.launch(crack_refresh_particles, dim=self.n_particles, inputs=[self.parts, self.params], device=d)
         lk.count.zero_()
         if self.n_static:
             wp.launch(collect_cell_links, dim=self.n_static,
@@ -229,7 +249,8 @@ class CrackGas:
         loaded = p >= PRESSURISED
         gap = g.gap.numpy()[: self.Q]
         return {
-            "wet_cells": int(wet.sum()), "cells_with_gas": int((mass > 0).sum()),
+            "wet_cells": int((wet > 0).sum()), "cells_with_gas": int((mass > 0).sum()),
+            "cells_handed_to_particles": int((wet == 2).sum()),
             "pressurised_cells": int(loaded.sum()),
             "mass": float(mass.sum()), "internal_energy": float(g.energy.numpy()[: self.Q].sum()),
             "max_pressure": float(p.max()) if self.Q else 0.0,

@@ -45,7 +45,8 @@ class CrackGasState:
 
     mass [kg/m]; energy: internal energy [J/m]; vol: volume max(V, w_min·L) [m²]; pres [Pa]; cs [m/s];
     gamma: ρc²/p [-]; gap: opening at the ends A and B, ≥ 0 [m] (vec2d); force: on the 4 nodes this step [N/m];
-    wet: 1 once both springs of the interface have broken; p_fixed: prescribed pressure [Pa] (≥ 0) instead of the
+    wet: 1 once both springs of the interface have broken, 2 once it opened wider than a material point and
+    handed its gas to the MPM (release_wide_cells); p_fixed: prescribed pressure [Pa] (≥ 0) instead of the
     EOS (verification); out: outflow asked of the cell this step [kg/m]; scale: fraction of it granted [-].
     """
 
@@ -173,7 +174,7 @@ def update_crack_cells(cells: CrackCells, gas: CrackGasState, prm: CrackGasParam
     the mean of the velocities before and after a step, the work the central-difference update receives.
     """
     q = wp.tid()
-    if pair_mode[2 * q] == 0 or pair_mode[2 * q + 1] == 0:
+    if pair_mode[2 * q] == 0 or pair_mode[2 * q + 1] == 0 or gas.wet[q] == 2:
         return
     gas.wet[q] = 1
     n = cells.nodes[q]
@@ -229,7 +230,7 @@ def collect_cell_links(pairs: wp.array(dtype=wp.vec2i), ends: wp.array(dtype=wp.
     """Append the static cell pairs (two interfaces sharing a vertex) whose cells are both wet."""
     k = wp.tid()
     c = pairs[k]
-    if wet[c[0]] == 0 or wet[c[1]] == 0:
+    if wet[c[0]] != 1 or wet[c[1]] != 1:
         return
     i = wp.atomic_add(links.count, 0, 1)
     links.a[i] = c[0]
@@ -247,7 +248,7 @@ def collect_mouths(cand_cell: wp.array(dtype=wp.int32), cand_end: wp.array(dtype
     particles: the candidate ends are few)."""
     k = wp.tid()
     q = cand_cell[k]
-    if wet[q] == 0:
+    if wet[q] != 1:
         return
     end = cand_end[k]
     n = cells.nodes[q]
@@ -466,3 +467,52 @@ def crack_refresh_particles(parts: GasParticles, prm: CrackGasParams):
     parts.pres[r] = p
     s = -(p + parts.q[r])
     parts.stress[r] = wp.mat22d(s, F64(0.0), F64(0.0), s)
+
+
+@wp.kernel
+def release_wide_cells(cells: CrackCells, gas: CrackGasState, parts: GasParticles, n_particles: int,
+                       x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), d_particle: wp.float64,
+                       radius: wp.float64, dt_prev: wp.float64, released: wp.array(dtype=wp.int32)):
+    """A wet cell open wider than a material point at both ends belongs to the MPM: its gas (mass, internal
+    energy and volume) joins the nearest fully burnt particle within ``radius`` of its centre, and the cell is
+    marked open (wet = 2) for good: particles, not crack cells, load such a crack (by contact). The last step's
+    face forces get their pending half-step of work first, so the energy stays balanced."""
+    q = wp.tid()
+    if gas.wet[q] != 1:
+        return
+    g = gas.gap[q]
+    if wp.min(g[0], g[1]) <= d_particle:
+        return
+    n = cells.nodes[q]
+    c = F64(0.25) * (x[n[0]] + x[n[1]] + x[n[2]] + x[n[3]])
+    best = int(-1)
+    d2best = radius * radius
+    for r in range(n_particles):
+        if parts.active[r] == 0 or parts.burn[r] < F64(1.0):
+            continue
+        d = parts.x[r] - c
+        d2 = wp.dot(d, d)
+        if d2 < d2best:
+            d2best = d2
+            best = r
+    if best < 0:
+        return
+    w_old = F64(0.0)
+    for k in range(4):
+        w_old += wp.dot(gas.force[4 * q + k], v[n[k]])
+        gas.force[4 * q + k] = wp.vec2d(F64(0.0), F64(0.0))
+    e = gas.energy[q] - F64(0.5) * dt_prev * w_old
+    m = gas.mass[q]
+    if m > F64(0.0):
+        wp.atomic_add(parts.mass, best, m)
+        wp.atomic_add(parts.ie, best, e)
+        wp.atomic_add(parts.vol, best, gas.vol[q])
+        parts.touched[best] = 1
+    else:
+        gas.energy[q] = e            # nothing to hand over (an empty cell's work balance, kept in the books)
+    if m > F64(0.0):
+        gas.mass[q] = F64(0.0)
+        gas.energy[q] = F64(0.0)
+    gas.pres[q] = F64(0.0)
+    gas.wet[q] = 2
+    wp.atomic_add(released, 0, 1)
