@@ -143,6 +143,12 @@ class MPMSolver:
         self.charge_id = np.asarray(cid, np.int32)      # charge of each particle (host) [-]
         self.config = config
         self._build(x, vol, spec, params, opts, device, light_time=t_l)
+        for k, ch in enumerate(config.charges):        # gas regions: burnt products in a given state
+            st = getattr(ch, "gas_state", None)
+            if st is not None:
+                sel = self.charge_id == k
+                self.set_gas_state(st.density, st.pressure, np.broadcast_to(np.asarray(st.velocity, F64), (self.n, 2)),
+                                   mask=sel)
         self.walls = boundary_walls(config, spec)
         key = {"left": "xmin", "right": "xmax", "bottom": "ymin", "top": "ymax"}
         for kind in ("slip", "fixed"):
@@ -239,14 +245,30 @@ class MPMSolver:
             self.shape_l,
         )
 
-    def set_gas_state(self, rho: np.ndarray, p: np.ndarray, v: np.ndarray | None = None) -> None:
-        """Start the particles as fully burnt products in a given state (JWL only; e.g. a shock tube).
+    def set_gas_state(self, rho: np.ndarray, p: np.ndarray, v: np.ndarray | None = None,
+                      mask: np.ndarray | None = None) -> None:
+        """Start the particles (all, or those in ``mask``) as fully burnt products in a given state (JWL only;
+        e.g. a shock tube, a gas region of a scenario).
 
         rho [n] kg/m^3 and p [n] Pa per particle (v [n,2] m/s optional).  Keeps the volumes; sets
         m_p = rho V_p, the reference volume V_p0 = m_p / rho0 (so that V = rho0/rho and the JWL sound
-        speed are those of the given density), ie = E V_p0 with p = a(V) + (omega/V) E, F = 1, sigma = -p I
-        and c from the JWL.  ``energies()['initial_internal']`` becomes this state's internal energy.
+        speed are those of the given density), ie = E V_p0 with p = a(V) + (omega/V) E, F = 1, sigma = -p I,
+        c from the JWL and an infinite lighting time.  ``energies()['initial_internal']`` and ``chem0`` (the
+        energy the budget counts as supplied) become this state's internal energy.
         """
+        if mask is not None:
+            sel = np.asarray(mask, bool)
+            keep = {k: getattr(self, k).numpy().copy() for k in ("mass", "vol0", "vol_prev", "rho", "ie", "p", "q",
+                                                                 "burn", "stress", "cs", "b_aff", "v", "light_time")}
+            chem_keep, chem0_keep = self._chem0.copy(), self.chem0.copy()
+            self.set_gas_state(rho, p, v)
+            for k, old in keep.items():
+                new = getattr(self, k).numpy().copy()
+                new[~sel] = old[~sel]
+                getattr(self, k).assign(new)
+            self._chem0 = np.where(sel, self._chem0, chem_keep)
+            self.chem0 = np.where(sel, self.chem0, chem0_keep)
+            return
         if not self.is_jwl:
             raise TypeError("set_gas_state needs a JWL material")
         from blastfrac.materials.jwl import V_FLOOR, jwl_a_np
@@ -275,7 +297,8 @@ class MPMSolver:
         if v is not None:
             self.v.assign(np.asarray(v, F64).reshape(-1, 2))
         self._chem0 = ie.copy()
-        self.chem0 = P.E0 * vol0
+        self.chem0 = ie.copy()
+        self.light_time.fill_(np.inf)
 
     def _check_in_grid(self, x: np.ndarray) -> None:
         s = self.spec

@@ -43,12 +43,26 @@ class JWLConstants(_Model):
     E0: float = Field(gt=0, le=5e10, description="detonation energy per unit initial volume [J/m^3]")
 
 
+class GasState(_Model):
+    """Burnt products in a given state from t = 0 (a gas region: no burn, no chemical energy to release)."""
+
+    density: float = Field(gt=0, le=1e5, description="density of the products [kg/m^3]")
+    pressure: float = Field(ge=0, le=1e12, description="pressure [Pa]; the internal energy follows from the JWL")
+    velocity: Point = Field(default=(0.0, 0.0), description="velocity (vx, vy) [m/s]")
+
+
+_GAS_STATE_DOC = ("burnt products in this state from t = 0 instead of an explosive that detonates: a gas region "
+                  "(shock tube, gas-only run); its initial internal energy counts as the energy supplied "
+                  "(explosive_released)")
+
+
 class CircleCharge(_Model):
     """A circular charge (a borehole section in plane strain)."""
 
     kind: Literal["circle"] = Field(description="charge shape tag")
     center: Point = Field(description="centre (x, y) [m]")
     radius: float = Field(gt=0, description="radius [m]")
+    gas_state: GasState | None = Field(default=None, description=_GAS_STATE_DOC)
 
     @property
     def area(self) -> float:
@@ -73,6 +87,7 @@ class PolygonCharge(_Model):
 
     kind: Literal["polygon"] = Field(description="charge shape tag")
     vertices: list[Point] = Field(min_length=3, description="vertices (x, y) [m], at least 3")
+    gas_state: GasState | None = Field(default=None, description=_GAS_STATE_DOC)
 
     @model_validator(mode="after")
     def _simple(self) -> PolygonCharge:
