@@ -11,6 +11,7 @@ from .._warp import init_warp
 from ..geometry.mesh import TriMesh, generate_mesh
 from ..materials.elastic import lame
 from .compliance import elastic_report, spring_compliance_density
+from .heterogeneity import interface_factors, rms
 from ..materials.interface import softening_slope
 from ..scenario.schema import Scenario
 from .model import Model
@@ -58,6 +59,16 @@ class ModelBuilder:
             hbar = (area[e1] + area[e2]) / L          # mean of the two heights 2A/L
             kn_a = rock.spring_penalty * rock.plane_strain_modulus / hbar
             ks_a = kn_a.copy()
+        # heterogeneous rock: one unit-mean Weibull factor per interface and property, shared by the
+        # interface's two springs (model/heterogeneity.py); {} for a homogeneous rock
+        self.factors = interface_factors(rock.heterogeneity, len(L), sc.simulation.seed)
+        kn_min_nominal = float(kn_a.min()) if len(kn_a) else 1.0
+        ks_min_nominal = float(ks_a.min()) if len(ks_a) else 1.0
+        if "stiffness" in self.factors:
+            # per-area stiffness of each interface: the compliance compensation, the contact stiffness
+            # (mean of pair_kn_area), the platen penalty and the stable step below all see these values
+            kn_a = kn_a * self.factors["stiffness"]
+            ks_a = ks_a * self.factors["stiffness"]
         # block moduli: compensated for the springs' compliance so that the assembly has the input E, ν
         # (penalty mode by default), or the input itself (model/compliance.py)
         s_n, s_s = spring_compliance_density(L, kn_a, ks_a, float(area.sum()))
@@ -70,11 +81,21 @@ class ModelBuilder:
         h["pair_kn_area"] = np.repeat(kn_a, 2)
         h["pair_kn"] = np.repeat(kn_a * ac, 2)
         h["pair_ks"] = np.repeat(ks_a * ac, 2)
-        h["pair_t0"] = np.full(2 * len(L), rock.tensile_strength)
-        h["pair_c0"] = np.full(2 * len(L), rock.cohesion)
-        kmin = float(kn_a.min()) if len(kn_a) else 1.0
-        self.slope_t = softening_slope(rock.tensile_strength, rock.tensile_fracture_energy, kmin)
-        self.slope_c = softening_slope(rock.cohesion, rock.shear_fracture_energy, float(ks_a.min()) if len(ks_a) else 1.0)
+        t_q = np.full(len(L), rock.tensile_strength)
+        c_q = np.full(len(L), rock.cohesion)
+        if "tensile_strength" in self.factors:
+            t_q = t_q * self.factors["tensile_strength"]
+        if "cohesion" in self.factors:
+            c_q = c_q * self.factors["cohesion"]
+        h["pair_t0"] = np.repeat(t_q, 2)
+        h["pair_c0"] = np.repeat(c_q, 2)
+        # one softening rate per model (the spring kernels take a scalar): the homogeneous rule at the
+        # softest nominal spring, with the area-weighted rms strength of a scattered field. Interface q then
+        # dissipates G_f·(T_q/T_rms)², area-weighted mean G_f (docs/heterogeneity.md "Fracture energy")
+        t_ref = rms(t_q, L) if "tensile_strength" in self.factors and len(L) else rock.tensile_strength
+        c_ref = rms(c_q, L) if "cohesion" in self.factors and len(L) else rock.cohesion
+        self.slope_t = softening_slope(t_ref, rock.tensile_fracture_energy, kn_min_nominal)
+        self.slope_c = softening_slope(c_ref, rock.shear_fracture_energy, ks_min_nominal)
         # the unit normal of each interface, e1 → e2, for the stable-step row sums
         t = (X[nb] - X[na]) / L[:, None]
         h["iface_normal"] = np.stack([t[:, 1], -t[:, 0]], 1)
