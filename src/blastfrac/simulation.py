@@ -45,7 +45,7 @@ class RunInterrupted(RuntimeError):
 #: files a run writes that a later run into the same directory must not leave behind (stale frames)
 _RUN_OUTPUTS = ("rock_[0-9][0-9][0-9][0-9].vtu", "gas_[0-9][0-9][0-9][0-9].vtu", "rock.pvd", "gas.pvd",
                 CHECKPOINT_NAME, "summary.json", "monitors.csv", "energy.csv", "fracture_degree.csv",
-                "borehole_pressure.csv")
+                "borehole_pressure.csv", "fragments.csv")
 
 
 def clear_previous_outputs(out_dir: Path) -> int:
@@ -336,6 +336,7 @@ class Simulation:
         self._flush_histories()
         summary = self.summary(wall)
         write_summary(self.out_dir / "summary.json", summary)
+        self.write_fragments()
         if sc.output.figures:
             self.write_figures(self._mon, self._frac, self._energy, cracks=summary["cracks"])
         return summary
@@ -651,6 +652,7 @@ class Simulation:
             "elastic": m.elastic.as_dict(),
             "insitu_stage": self.insitu_report,
             "cracks": self.crack_statistics(),
+            "fragmentation": self.fragmentation()[1],
             "monitors": self.monitors.report(),
             "status": "completed",
             "warnings": list(self.warnings),
@@ -664,6 +666,22 @@ class Simulation:
             self._check_budget(err, rel, final=True)   # the final state is over the limit: warn now
             out["warnings"] = list(self.warnings)
         return out
+
+    def fragmentation(self) -> tuple[dict, dict]:
+        """(per-fragment arrays, summary report) of the present state (analysis/fragments.py)."""
+        from .analysis.fragments import fragmentation_report, fragments
+
+        fr = fragments(self.model, self.state)
+        return fr, fragmentation_report(fr)
+
+    def write_fragments(self) -> None:
+        """fragments.csv: one row per fragment, largest first (analysis/fragments.py)."""
+        from .io.tables import write_table
+
+        fr, _ = self.fragmentation()
+        cols = [("area", "m^2"), ("size", "m"), ("centroid_x", "m"), ("centroid_y", "m"), ("velocity_x", "m/s"),
+                ("velocity_y", "m/s"), ("blocks", "-"), ("touches_outer_boundary", "-")]
+        write_table(self.out_dir / "fragments.csv", [(f"{k} [{u}]", fr[k]) for k, u in cols])
 
     def crack_statistics(self) -> list[dict]:
         """Crushed-zone radius, radial crack count and lengths around each borehole (analysis.cracks)."""
@@ -717,6 +735,11 @@ class Simulation:
             figures.gas_particles(self.out_dir / "gas_pressure.png", f["position"], f["pressure"], x, seg, cmode,
                                   title=f"{title}: gas pressure at t = {self.time * 1e6:.1f} µs",
                                   gas_seg=gas_seg, gas_p=gas_p)
+        fr, frep = self.fragmentation()
+        figures.fragment_sizes(self.out_dir / "fragment_sizes.png", fr["size"], fr["area"],
+                               ~fr["touches_outer_boundary"], frep,
+                               title=f"{title}: fragment sizes at t = {self.time * 1e6:.1f} µs (fragments not touching "
+                                     "the outer boundary; single blocks are at the mesh scale)")
         cracks = self.crack_statistics() if cracks is None else cracks
         if cracks:
             figures.crack_profile(self.out_dir / "crack_profile.png", cracks,

@@ -103,3 +103,15 @@ def write_summary(path: Path, summary: dict) -> None:
     """Write ``summary`` as strict JSON (non-finite numbers as ``null``), atomically."""
     text = json.dumps(json_safe(summary), indent=2, sort_keys=False, allow_nan=False)
     write_text_atomic(path, text + "\n")
+
+
+def write_table(path: str | Path, columns: list[tuple[str, np.ndarray]]) -> None:
+    """A CSV of equal-length columns (header names with units, e.g. 'area [m^2]'), written atomically; booleans
+    as 0/1."""
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow([name for name, _ in columns])
+    cols = [np.asarray(c) for _, c in columns]
+    for i in range(len(cols[0]) if cols else 0):
+        w.writerow([f"{int(c[i])}" if c.dtype.kind in "bi" else f"{float(c[i]) + 0.0:.9g}" for c in cols])
+    write_text_atomic(Path(path), buf.getvalue())

@@ -253,3 +253,41 @@ def _detached_note(s: dict) -> str:
         return "detached sets not computed"
     return (f"{s['detached_crack_sets']} detached sets ({s['detached_crack_sets_long']} with > 3 interfaces), "
             f"{s['detached_crack_length'] * 1e3:.0f} mm in all")
+
+
+def fragment_sizes(path: Path, size: np.ndarray, area: np.ndarray, blasted: np.ndarray, report: dict,
+                   title: str = "") -> None:
+    """Passing curve (mass fraction finer than x) of the blasted fragments with x50, x80 and the Swebrec fit."""
+    from ..analysis.fragments import passing_curve, swebrec
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=150)
+    if blasted.any():
+        x, P = passing_curve(size[blasted], area[blasted])
+        ax.step(x * 1e3, 100 * P, where="post", color="k", label=f"{int(blasted.sum())} blasted fragments")
+        sw = report.get("swebrec", {})
+        if np.isfinite(sw.get("x50", np.nan)):
+            xs = np.geomspace(x[0], sw["x_max"], 200)
+            bad = bool(sw.get("at_bound"))
+            ax.plot(xs * 1e3, 100 * swebrec(xs, sw["x50"], sw["x_max"], sw["b"]), color="tab:orange",
+                    ls="--" if bad else "-",
+                    label=f"Swebrec x50 {sw['x50'] * 1e3:.1f} mm, x_max {sw['x_max'] * 1e3:.1f} mm, b {sw['b']:.2f}"
+                    + (f" (not Swebrec-like: {', '.join(sw['at_bound'])} on its bound)" if bad else ""))
+        for q, key in ((50, "x50"), (80, "x80")):
+            v = report.get(key)
+            if v is not None and np.isfinite(v):
+                ax.axvline(v * 1e3, color="0.5", lw=0.8, ls=":")
+                ax.text(v * 1e3, q, f" {key} {v * 1e3:.1f} mm", fontsize=7, va="bottom")
+        ax.set_xscale("log")
+    else:
+        ax.text(0.5, 0.5, "no fragment detached from the rock mass", transform=ax.transAxes, ha="center")
+    ax.set_xlabel("fragment size x = 2√(A/π) [mm]")
+    ax.set_ylabel("passing (area = mass fraction finer) [%]")
+    ax.set_ylim(0, 100)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, loc="upper left")
+    ax.set_title(textwrap.fill(title or "Fragment sizes (fragments not touching the outer boundary; single blocks "
+                                        "are at the mesh scale)", 90), fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
