@@ -45,7 +45,7 @@ class RunInterrupted(RuntimeError):
 #: files a run writes that a later run into the same directory must not leave behind (stale frames)
 _RUN_OUTPUTS = ("rock_[0-9][0-9][0-9][0-9].vtu", "gas_[0-9][0-9][0-9][0-9].vtu", "rock.pvd", "gas.pvd",
                 CHECKPOINT_NAME, "summary.json", "monitors.csv", "energy.csv", "fracture_degree.csv",
-                "borehole_pressure.csv", "fragments.csv")
+                "borehole_pressure.csv", "fragments.csv", "ppv_profile.csv")
 
 
 def clear_previous_outputs(out_dir: Path) -> int:
@@ -129,6 +129,9 @@ class Simulation:
         self.coupler = None
         self.crack_gas = None
         self.wall_load = None
+        from .analysis.ppv import PeakVelocity
+
+        self.ppv = PeakVelocity(self.model.node_count, self.device)      # peak particle velocity per node
         self.gas_report: dict = {}
         if scenario.explosive is not None:
             self._build_explosive()
@@ -219,6 +222,7 @@ class Simulation:
             self.gas.to_grid(dt)                           # P2G with the contact forces
             self.gas.update_grid(dt)
         self.cdem.integrate(st, dt, self.alpha)            # central difference on rock nodes
+        self.ppv.update(st.v)                              # PPV: max |v| per node
         if couple:
             self.gas.to_particles(dt)                      # G2P, MUSL remap, particle motion
             self.gas.update_eos(dt, self.time)             # burn, viscosity, JWL
@@ -271,6 +275,7 @@ class Simulation:
         self.state.pair_tbreak.assign(tb)
         self.state.v.zero_()
         self.state.energy_acc.zero_()
+        self.ppv.ppv.zero_()                         # vibration is the blast's, not the relaxation's
         self.cdem.dt_prev = 0.0
         self.initial_dissipated = self.cdem.rebase_spring_work(self.state)
         e = rock_energies(self.model, self.state)
@@ -337,6 +342,7 @@ class Simulation:
         summary = self.summary(wall)
         write_summary(self.out_dir / "summary.json", summary)
         self.write_fragments()
+        self.write_vibration()
         if sc.output.figures:
             self.write_figures(self._mon, self._frac, self._energy, cracks=summary["cracks"])
         return summary
@@ -460,7 +466,7 @@ class Simulation:
                     self._next_sample += self._sample_dt
                 if self.time >= self._next_frame - 1e-15:
                     if series is not None:
-                        series.write(self.model, self.state, self.time, crack_gas=self.crack_gas)
+                        series.write(self.model, self.state, self.time, crack_gas=self.crack_gas, ppv=self.ppv.values())
                     if gas_series is not None:
                         gas_series.write(self.gas, self.time)
                     self._next_frame += self._frame_dt
@@ -488,7 +494,7 @@ class Simulation:
                 self.write_checkpoint()            # later end_time continues from here
             self._sample()
             if series is not None:
-                series.write(self.model, self.state, self.time, crack_gas=self.crack_gas)
+                series.write(self.model, self.state, self.time, crack_gas=self.crack_gas, ppv=self.ppv.values())
             if gas_series is not None:
                 gas_series.write(self.gas, self.time)
             if self._k_snap < len(self._snap_times) or not self.snapshots:
@@ -653,6 +659,7 @@ class Simulation:
             "insitu_stage": self.insitu_report,
             "cracks": self.crack_statistics(),
             "fragmentation": self.fragmentation()[1],
+            "vibration": self.vibration()[0],
             "monitors": self.monitors.report(),
             "status": "completed",
             "warnings": list(self.warnings),
@@ -674,6 +681,24 @@ class Simulation:
         fr = fragments(self.model, self.state)
         return fr, fragmentation_report(fr)
 
+    def vibration(self) -> tuple[dict | None, dict | None]:
+        """(summary.json → vibration, ring profile) from the nodes' PPV about the holes (analysis/ppv.py); (None,
+        None) without a hole or charge to measure distances from."""
+        from .analysis.ppv import vibration_report
+
+        centres = self.crack_centres()
+        if not centres:
+            return None, None
+        Q = None
+        if self.gas is not None:
+            Q = float(self.gas.mass0_total) / len(centres)
+        rep, prof = vibration_report(self.model.host["node_X"], self.ppv.values(), centres, Q if Q else 1.0,
+                                     self.scenario.rock)
+        if Q is None:
+            rep["charge_per_hole"] = None
+            rep["attenuation"]["law"] = "PPV = K R^-beta (no charge: R unscaled)"
+        return rep, prof
+
     def write_fragments(self) -> None:
         """fragments.csv: one row per fragment, largest first (analysis/fragments.py)."""
         from .io.tables import write_table
@@ -682,6 +707,15 @@ class Simulation:
         cols = [("area", "m^2"), ("size", "m"), ("centroid_x", "m"), ("centroid_y", "m"), ("velocity_x", "m/s"),
                 ("velocity_y", "m/s"), ("blocks", "-"), ("touches_outer_boundary", "-")]
         write_table(self.out_dir / "fragments.csv", [(f"{k} [{u}]", fr[k]) for k, u in cols])
+
+    def write_vibration(self) -> None:
+        """ppv_profile.csv: the ring medians and maxima of the PPV against the distance from the holes."""
+        from .io.tables import write_table
+
+        _, prof = self.vibration()
+        if prof is not None:
+            write_table(self.out_dir / "ppv_profile.csv", [("radius [m]", prof["radius"]), ("ppv_median [m/s]", prof["median"]),
+                                                            ("ppv_max [m/s]", prof["max"]), ("nodes [-]", prof["nodes"])])
 
     def crack_statistics(self) -> list[dict]:
         """Crushed-zone radius, radial crack count and lengths around each borehole (analysis.cracks)."""
@@ -740,6 +774,13 @@ class Simulation:
                                ~fr["touches_outer_boundary"], frep,
                                title=f"{title}: fragment sizes at t = {self.time * 1e6:.1f} µs (fragments not touching "
                                      "the outer boundary; single blocks are at the mesh scale)")
+        vib, prof = self.vibration()
+        if vib is not None:
+            figures.ppv_map(self.out_dir / "ppv_map.png", self.model.host["node_X"], self.ppv.values(),
+                            self.crack_centres(), vib, title=f"{title}: peak particle velocity up to "
+                                                             f"t = {self.time * 1e6:.1f} µs")
+            figures.ppv_distance(self.out_dir / "ppv_distance.png", prof, vib,
+                                 title=f"{title}: PPV against the distance from the hole")
         cracks = self.crack_statistics() if cracks is None else cracks
         if cracks:
             figures.crack_profile(self.out_dir / "crack_profile.png", cracks,

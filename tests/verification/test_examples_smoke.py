@@ -9,7 +9,8 @@ from blastfrac.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 SCENARIOS = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "examples").glob("*/*.toml")
-                   if p.parent.name != "calibration")
+                   if p.parent.name != "calibration" and not p.name.startswith("sweep"))
+SWEEPS = sorted(str(p.relative_to(ROOT)) for p in (ROOT / "examples").glob("*/sweep*.toml"))
 
 
 @pytest.mark.parametrize("path", SCENARIOS)
@@ -21,3 +22,13 @@ def test_example_runs_a_few_steps(path, tmp_path):
     assert s["steps"] == 3
     assert s["counts"]["elements"] > 1000
     assert (tmp_path / "resolved.toml").exists()
+
+
+@pytest.mark.parametrize("path", SWEEPS)
+def test_shipped_sweeps_are_valid(path):
+    """Every case of a shipped sweep loads and validates (the sweep itself: make validate / blastfrac sweep)."""
+    from blastfrac.sweep import load_sweep, validate_cases
+
+    sw = load_sweep(ROOT / path)
+    validate_cases(sw)
+    assert len(sw.cases) >= 2

@@ -28,14 +28,14 @@ from .atomic import write_atomic
 
 FORMAT = 1
 #: the run's objects whose attributes make its time-varying state, by their path from the Simulation
-STAGES = ("", "state", "cdem", "cdem.contact", "coupler", "gas", "gas.grid", "crack_gas", "wall_load")
+STAGES = ("", "state", "cdem", "cdem.contact", "coupler", "gas", "gas.grid", "crack_gas", "wall_load", "ppv")
 #: attributes never saved: static data rebuilt from the scenario, handles, or the objects walked separately
 SKIP = {"model", "mesh", "scenario", "topology", "builder", "config", "material", "opts", "spec", "device",
         "mpm", "monitors", "fracture", "params", "cells", "static_pairs", "static_ends", "static_dx",
         "cand_cell", "cand_end", "host_length", "out_dir", "max_steps", "contact", "snapshots", "warnings",
         "insitu_report", "gas_report"}
 #: the stage objects hanging from the Simulation (walked as stages, not as its attributes)
-ROOT_STAGES = {"state", "cdem", "coupler", "gas", "crack_gas", "wall_load"}
+ROOT_STAGES = {"state", "cdem", "coupler", "gas", "crack_gas", "wall_load", "ppv"}
 
 
 def scenario_hash(text: str) -> str:

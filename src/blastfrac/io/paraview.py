@@ -8,7 +8,7 @@ Both cell fields exist on both cell blocks, so that no reader sees a hole or a N
 is 0 on the triangles, ``stress`` is 0 on the crack lines (a crack carries no stress tensor; select
 the blocks with ``crack_mode == 0``). The stress is the full 3×3 plane-strain tensor [Pa], tension
 positive, with σ_zz = ν(σ_xx + σ_yy), ν = λ/(2(λ + μ)) the Poisson ratio of the blocks (ε_zz = 0).
-With gas in cracks, the crack lines also carry ``crack_gas_pressure`` [Pa] and ``crack_opening`` [m] (0 on the
+Point field ``ppv``: the peak particle velocity of each node so far [m/s]. With gas in cracks, the crack lines also carry ``crack_gas_pressure`` [Pa] and ``crack_opening`` [m] (0 on the
 triangles and on cracks with one spring broken). Every file is written atomically (io/atomic.py): a killed run leaves whole frames only.
 """
 
@@ -58,7 +58,7 @@ class ParaviewSeries:
         self.name = name
         self.frames: list[tuple[float, str]] = []
 
-    def write(self, model, state, t: float, crack_gas=None) -> None:
+    def write(self, model, state, t: float, crack_gas=None, ppv=None) -> None:
         """One frame; with ``crack_gas`` (coupling.crack_gas.CrackGas) the crack lines also carry
         ``crack_gas_pressure`` [Pa] and ``crack_opening`` (the larger end opening) [m], 0 on the triangles."""
         x = state.x.numpy()
@@ -87,7 +87,8 @@ class ParaviewSeries:
         mesh = meshio.Mesh(
             pts, cells,
             point_data={"displacement": np.c_[u, np.zeros(len(u))], "velocity": np.c_[v, np.zeros(len(v))],
-                        "displacement_magnitude": np.linalg.norm(u, axis=1)},
+                        "displacement_magnitude": np.linalg.norm(u, axis=1),
+                        **({"ppv": np.asarray(ppv, float)} if ppv is not None else {})},
             cell_data=cell_data,
         )
         fname = f"{self.name}_{len(self.frames):04d}.vtu"

@@ -202,6 +202,7 @@ class MPMSolver:
         self.f_ext_moment = z(wp.mat22d)
         self.b_aff = z(wp.mat22d)
         self.mass = wp.array(rho0 * vol, dtype=wp.float64, device=d)
+        self.mass0_total = float(np.sum(rho0 * vol))       # the charges' mass at seeding [kg/m]
         self.vol = wp.array(vol, dtype=wp.float64, device=d)
         self.vol0 = wp.array(vol, dtype=wp.float64, device=d)
         self.vol_prev = wp.array(vol, dtype=wp.float64, device=d)

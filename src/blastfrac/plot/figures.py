@@ -291,3 +291,64 @@ def fragment_sizes(path: Path, size: np.ndarray, area: np.ndarray, blasted: np.n
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def ppv_map(path: Path, X: np.ndarray, ppv: np.ndarray, centres: list, vib: dict, title: str = "") -> None:
+    """Peak particle velocity over the rock (per block, the mean of its nodes; log colour scale), with the damage
+    radius (PPV_crit = σ_t c_p/E) drawn about each hole."""
+    plt = _plt()
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import LogNorm
+
+    fig, ax = plt.subplots(figsize=(7, 6), dpi=150)
+    tri = X.reshape(-1, 3, 2)
+    val = np.maximum(ppv.reshape(-1, 3).mean(axis=1), 1e-3)
+    crit = vib["ppv_critical"]
+    pc = PolyCollection(tri, array=val, cmap="viridis", norm=LogNorm(vmin=max(val.min(), 1e-2), vmax=val.max()),
+                        edgecolors="none")
+    ax.add_collection(pc)
+    fig.colorbar(pc, ax=ax, label="peak particle velocity [m/s]")
+    rd = vib.get("damage_radius")
+    th = np.linspace(0, 2 * np.pi, 200)
+    for (c, r) in centres:
+        if rd is not None and np.isfinite(rd):
+            ax.plot(c[0] + rd * np.cos(th), c[1] + rd * np.sin(th), color="w", lw=1.2, ls="--")
+    if rd is not None and np.isfinite(rd):
+        edge = " ≥, to the model's edge" if vib.get("damage_beyond_model") else ""
+        ax.plot([], [], color="k", ls="--", label=f"damage radius{edge} {rd * 1e3:.0f} mm (PPV > PPV_crit = σ_t c_p/E "
+                                                   f"= {crit:.1f} m/s)")
+        ax.legend(fontsize=7, loc="upper right")
+    ax.set_xlim(X[:, 0].min(), X[:, 0].max())
+    ax.set_ylim(X[:, 1].min(), X[:, 1].max())
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(textwrap.fill(title or "Peak particle velocity", 80), fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def ppv_distance(path: Path, prof: dict, vib: dict, title: str = "") -> None:
+    """Ring medians and maxima of the PPV against the distance from the holes, the fitted law and PPV_crit."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.2), dpi=150)
+    R = prof["radius"]
+    ax.loglog(R * 1e3, prof["median"], "o", ms=3, color="k", label="ring median")
+    ax.loglog(R * 1e3, prof["max"], ".", ms=3, color="0.6", label="ring maximum")
+    at = vib["attenuation"]
+    Q = vib.get("charge_per_hole") or 1.0
+    if np.isfinite(at.get("K", np.nan)):
+        Rf = R[R > at["fit_from_radius"]]
+        if len(Rf):
+            ax.loglog(Rf * 1e3, at["K"] * (Rf / np.sqrt(Q)) ** (-at["beta"]), color="tab:orange",
+                      label=f"fit K (R/√Q)^-β: K = {at['K']:.3g}, β = {at['beta']:.2f} (R² {at['r2']:.3f})")
+    ax.axhline(vib["ppv_critical"], color="tab:red", lw=0.8, ls="--", label=f"PPV_crit = σ_t c_p/E = {vib['ppv_critical']:.1f} m/s")
+    ax.set_xlabel("distance from the hole centre R [mm]")
+    ax.set_ylabel("peak particle velocity [m/s]")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    ax.set_title(textwrap.fill(title or "PPV against distance", 90), fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
