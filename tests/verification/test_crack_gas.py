@@ -1,4 +1,4 @@
-"""Gas in cracks (coupling/crack_gas.py) against the classical solutions, CRACK_GAS.md §5:
+"""Gas in cracks (coupling/crack_gas.py) against the classical solutions (docs/validation.md §6):
 
 * a Griffith crack of half-length a under internal pressure p opens as w(x) = 4p(1 − ν²)/E·√(a² − x²) (plane
   strain): the crack-cell face loads on the block–spring rock, three meshes, the error falling with h;
