@@ -12,9 +12,13 @@ def add_parser(sub) -> None:
     p.add_argument("--device", default="cpu", help="cpu, cuda or cuda:N")
     p.add_argument("--steps", type=int, default=20, help="timed steps per size")
     p.add_argument("--quick", action="store_true", help="small sizes only (smoke run)")
-    p.add_argument("--only", choices=("cdem", "mpm", "examples"), default=None,
+    p.add_argument("--only", choices=("cdem", "mpm", "examples", "coupled"), default=None,
                    help="one suite; default: cdem and mpm ('examples' runs the paper's examples at full resolution, "
-                   "minutes)")
+                   "minutes; 'coupled' times the demo and confined P0 whole and per stage, intact and cracked, on 1 "
+                   "and 2 cores)")
+    p.add_argument("--reference", default=None, metavar="DIR",
+                   help="also build the C++ reference of DIR (../shared/bench-reference) in a scratch copy and run "
+                        "its CDEM and MPM loops on one thread beside blastfrac's, as ratios per element-step")
     p.set_defaults(func=run)
 
 
@@ -58,6 +62,22 @@ def run(args) -> int:
         for r in rows:
             print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['particle_steps_per_s']:.3e} |")
         print(f"scaling slope: {_load('bench_cdem').scaling_slope(rows, 'n_particles'):.3f}")
+    if args.only == "coupled":
+        cp = _load("bench_coupled")
+        rows = []
+        for name in cp.CASES:
+            r = cp.run_case(name, device, steps=max(args.steps, 50))
+            r["one_core_wall_s"] = cp.one_core_wall(name, device) if device == "cpu" else None
+            rows.append(r)
+        print(f"Coupled step on {device} (outputs off)")
+        print(cp.markdown(rows))
+    if args.reference:
+        cp = _load("bench_coupled")
+        from pathlib import Path as _P
+
+        ref = cp.run_reference(_P(args.reference), steps=args.steps, device=device)
+        print("\nblastfrac against the compiled reference (same machine, same run, one thread)")
+        print(cp.reference_markdown(ref))
     if args.only == "examples":
         ex = _load("bench_examples")
         rows = ex.run(device=device)

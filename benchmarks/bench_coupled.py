@@ -1,0 +1,180 @@
+"""The coupled blast step as a user runs it (issue 14 item 5): `blastfrac bench --only coupled`.
+
+For the demo (examples/circular_rock/demo.toml) and the confined example at P = 0, outputs off:
+
+* the whole run: steps, wall time, element-steps/s and particle-steps/s;
+* per stage, at the intact start and at the cracked end state (``steps`` timed steps each, synchronised per
+  stage): rock forces (springs, CST, loads, block contact), particle–edge contact, crack gas (when on), P2G and
+  grid update, rock integration, G2P, burn and EOS, and the ``wp.launch`` calls per step;
+* the whole run again pinned to one core (``taskset -c 0``, in a subprocess) against both cores.
+
+``--reference DIR`` (run_reference) builds ``../shared/bench-reference`` in a scratch copy and runs its C++
+float64 CDEM and MPM loops on one thread beside blastfrac's CDEM and MPM benchmarks at the same sizes; the
+ratio is blastfrac ÷ reference per element-step (particle-step).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = {"demo": ("examples/circular_rock/demo.toml", []),
+         "confined_P0": ("examples/confined_blast/scenario_P0.toml", [])}
+QUIET = ["output.paraview=false", "output.figures=false", "simulation.progress=false"]
+
+
+def _sim(path: str, extra: list[str], device: str, out: str):
+    from blastfrac.scenario import load_scenario
+    from blastfrac.simulation import Simulation
+
+    sc = load_scenario(ROOT / path, QUIET + extra)
+    return Simulation(sc, out_dir=out, device=device)
+
+
+def stage_times(sim, steps: int) -> dict:
+    """Seconds per step of each stage over ``steps`` steps (the step's own order), and launches per step."""
+    import warp as wp
+
+    st, dt = sim.state, sim.dt
+    T: dict[str, float] = {}
+    count = [0]
+    launch = wp.launch
+
+    def counting(*a, **k):
+        count[0] += 1
+        return launch(*a, **k)
+
+    def tm(name, f):
+        t0 = time.perf_counter()
+        f()
+        wp.synchronize()
+        T[name] = T.get(name, 0.0) + time.perf_counter() - t0
+
+    wp.launch = counting
+    try:
+        for _ in range(steps):
+            tm("rock forces", lambda: sim.cdem.forces(st, dt, sim.time))
+            if sim.gas is not None:
+                tm("particle-edge contact", lambda: sim.coupler.apply(st, dt))
+                if sim.wall_load is not None:
+                    tm("wall load", lambda: sim.wall_load.accumulate(sim.coupler.f_react, dt))
+                if sim.crack_gas is not None:
+                    tm("crack gas", lambda: sim.crack_gas.apply(st, dt))
+                tm("P2G + grid", lambda: (sim.gas.to_grid(dt), sim.gas.update_grid(dt)))
+            tm("rock integrate + PPV", lambda: (sim.cdem.integrate(st, dt, sim.alpha), sim.ppv.update(st.v)))
+            if sim.gas is not None:
+                tm("G2P", lambda: sim.gas.to_particles(dt))
+                tm("burn + EOS", lambda: sim.gas.update_eos(dt, sim.time))
+            sim.time += dt
+            sim.steps += 1
+    finally:
+        wp.launch = launch
+    out = {k: v / steps for k, v in T.items()}
+    out["total"] = sum(out.values())
+    out["launches_per_step"] = count[0] / steps
+    return out
+
+
+def run_case(name: str, device: str = "cpu", steps: int = 100) -> dict:
+    path, extra = CASES[name]
+    with tempfile.TemporaryDirectory() as tmp:
+        sim = _sim(path, extra, device, tmp)
+        intact = stage_times(_sim(path, extra, device, tmp + "/i"), steps)
+        t0 = time.perf_counter()
+        s = sim.run(progress=False)
+        wall = time.perf_counter() - t0
+        cracked = stage_times(sim, steps)
+    c = s["counts"]
+    return {"case": name, "elements": c["elements"], "particles": c["particles"], "steps": s["steps"],
+            "run_wall_s": s["wall_time_s"], "with_setup_s": wall,
+            "element_steps_per_s": c["elements"] * s["steps"] / s["wall_time_s"],
+            "particle_steps_per_s": c["particles"] * s["steps"] / s["wall_time_s"],
+            "intact_ms": {k: 1e3 * v for k, v in intact.items() if k != "launches_per_step"},
+            "cracked_ms": {k: 1e3 * v for k, v in cracked.items() if k != "launches_per_step"},
+            "launches_per_step": cracked["launches_per_step"], "broken_springs": s["broken_springs"]["total"]}
+
+
+def one_core_wall(name: str, device: str = "cpu") -> float | None:
+    """Run-loop wall time of a case pinned to one core (taskset), in a subprocess; None without taskset."""
+    if shutil.which("taskset") is None:
+        return None
+    path, extra = CASES[name]
+    code = ("import json,sys,tempfile; sys.path.insert(0, %r); import bench_coupled as b\n"
+            "with tempfile.TemporaryDirectory() as t:\n"
+            "    s = b._sim(%r, %r, %r, t).run(progress=False)\n"
+            "print('WALL', s['wall_time_s'])") % (str(Path(__file__).parent), path, extra, device)
+    r = subprocess.run(["taskset", "-c", "0", sys.executable, "-c", code], capture_output=True, text=True)
+    for line in r.stdout.splitlines():
+        if line.startswith("WALL"):
+            return float(line.split()[1])
+    return None
+
+
+def markdown(rows: list[dict]) -> str:
+    out = ["| case | elements | particles | steps | run wall [s] | 1 core [s] | element-steps/s | particle-steps/s "
+           "| launches/step | step intact [ms] | step cracked [ms] |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in rows:
+        one = r.get("one_core_wall_s")
+        one_txt = f"{one:.1f}" if one else "-"
+        out.append(f"| {r['case']} | {r['elements']:,} | {r['particles']:,} | {r['steps']:,} | {r['run_wall_s']:.1f} "
+                   f"| {one_txt} | {r['element_steps_per_s']:.3e} | {r['particle_steps_per_s']:.3e} "
+                   f"| {r['launches_per_step']:.1f} | {r['intact_ms']['total']:.2f} | {r['cracked_ms']['total']:.2f} |")
+    stages = sorted({k for r in rows for k in r["cracked_ms"] if k != "total"})
+    out += ["", "Per stage [ms/step], intact start / cracked end:", "| stage | " + " | ".join(r["case"] for r in rows) + " |",
+            "|---|" + "---:|" * len(rows)]
+    for k in stages:
+        out.append(f"| {k} | " + " | ".join(f"{r['intact_ms'].get(k, 0):.3f} / {r['cracked_ms'].get(k, 0):.3f}"
+                                            for r in rows) + " |")
+    return "\n".join(out)
+
+
+# ----------------------------------------------------------------------------- compiled reference
+def run_reference(src: Path, steps: int = 20, device: str = "cpu") -> list[dict]:
+    """Build the C++ reference in a scratch copy and run it beside blastfrac's CDEM and MPM benchmarks."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    import bench_cdem
+    import bench_mpm
+
+    scratch = Path(tempfile.mkdtemp(prefix="bench_ref_"))
+    dst = scratch / "ref"
+    shutil.copytree(src, dst)
+    subprocess.run(["bash", "build.sh", sys.executable], cwd=dst, check=True, capture_output=True)
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+
+    def ref(*args, scatter):
+        r = subprocess.run(["./bench_cpp_f64", *args], cwd=dst, env={**env, "SCATTER": scatter},
+                           capture_output=True, text=True, check=True)
+        line = next(l for l in r.stdout.splitlines() if l.startswith("RESULT"))
+        return json.loads(line.split(" ", 1)[1])
+
+    rows = []
+    rc = ref("cdem", scatter="colour")
+    bc = bench_cdem.run((200_000,), steps, device)[0]
+    rows.append({"loop": "CDEM", "size": bc["elements"], "blastfrac_per_s": bc["element_steps_per_s"],
+                 "reference_per_s": rc["units_steps_per_s"], "reference_size": rc.get("elements", 199_712),
+                 "reference": rc})
+    for n in (100_000, 400_000):
+        rm = ref("mpm", str(n), scatter="private")
+        bm = bench_mpm.run((n,), steps, device)[0]
+        rows.append({"loop": "MPM", "size": bm["n_particles"], "blastfrac_per_s": bm["particle_steps_per_s"],
+                     "reference_per_s": rm["units_steps_per_s"], "reference_size": n, "reference": rm})
+    for r in rows:
+        r["ratio_time_per_unit"] = r["reference_per_s"] / r["blastfrac_per_s"]
+    shutil.rmtree(scratch, ignore_errors=True)
+    return rows
+
+
+def reference_markdown(rows: list[dict]) -> str:
+    out = ["| loop | blastfrac size | blastfrac units-steps/s | C++ f64 1 thread units-steps/s | blastfrac ÷ C++ per unit-step |",
+           "|---|---:|---:|---:|---:|"]
+    for r in rows:
+        out.append(f"| {r['loop']} | {r['size']:,} | {r['blastfrac_per_s']:.3e} | {r['reference_per_s']:.3e} "
+                   f"| {r['ratio_time_per_unit']:.2f} |")
+    return "\n".join(out)
