@@ -62,11 +62,11 @@ def stage_times(sim, steps: int) -> dict:
         for _ in range(steps):
             tm("rock forces", lambda: sim.cdem.forces(st, dt, sim.time))
             if sim.gas is not None:
-                tm("particle-edge contact", lambda: sim.coupler.apply(st, dt))
+                tm("particle-edge contact", lambda: (sim.coupler.apply(st, dt), sim.coupler.add_reactions(st)))
                 if sim.wall_load is not None:
                     tm("wall load", lambda: sim.wall_load.accumulate(sim.coupler.f_react, dt))
                 if sim.crack_gas is not None:
-                    tm("crack gas", lambda: sim.crack_gas.apply(st, dt))
+                    tm("crack gas", lambda: (sim.crack_gas.apply(st, dt), sim.crack_gas.add_loads(st)))
                 tm("P2G + grid", lambda: (sim.gas.to_grid(dt), sim.gas.update_grid(dt)))
             tm("rock integrate + PPV", lambda: (sim.cdem.integrate(st, dt, sim.alpha), sim.ppv.update(st.v)))
             if sim.gas is not None:

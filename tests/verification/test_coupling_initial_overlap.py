@@ -112,10 +112,12 @@ def test_switch_of_deepest_feature_keeps_the_force_continuous():
     mpm = MPMSolver.from_arrays(x1, np.array([4 * rp * rp]), spec, gas, MPMOptions(), burn=np.zeros(1))
     cp = GasRockCoupler(model, mpm, kc=kc, rebuild_interval=1)
     cp.apply(st, 1e-9)
+    cp.add_reactions(st)
     f1 = np.linalg.norm(mpm.f_ext_p.numpy()[0])
     mpm.x.assign(np.array([[L - 0.3 * rp, 0.9 * rp]]))   # inside the corner: bottom edge 1.9 r_p deep, right 1.3
     st.f.zero_()
     cp.apply(st, 1e-9)
+    cp.add_reactions(st)
     f2 = mpm.f_ext_p.numpy()[0]
     slack = NEW_CONTACT_SLACK_NP * rp
     print(f"\n  first contact {f1 / (kc * slack):.2f}, after the switch {np.linalg.norm(f2) / (kc * slack):.2f} k_c·slack; "

@@ -50,6 +50,7 @@ def test_gas_piston_follows_lagrange_ballistics():
     for k in range(n):
         rock.forces(st, dt, k * dt)
         coupler.apply(st, dt)
+        coupler.add_reactions(st)
         mpm.to_grid(dt)
         mpm.update_grid(dt)
         rock.integrate(st, dt)

@@ -42,6 +42,7 @@ def _griffith_opening(n_per_a: int, a=0.01, width=0.2, p=10e6):
     cg.set_fixed_pressure(q, p)
     st.f.zero_()
     cg.apply(st, 0.0)                                       # face loads of the cells at the reference positions
+    cg.add_loads(st)
     f = st.f.numpy()
     lift = f[f[:, 1] > 0, 1].sum() / (2 * a * p)
     h = m.host

@@ -35,7 +35,15 @@ class CDEMSolver:
 
     def forces(self, state: State, dt: float, t: float) -> None:
         """Stage 3 of a step: element stresses and forces, springs with failure, loads, block contact."""
-        launch_spring_forces(self.model, state, dt, t)            # 3a springs, failure, broken-pair contact
+        self.forces_springs(state, dt, t)
+        self.forces_rest(state, dt, t)
+
+    def forces_springs(self, state: State, dt: float, t: float) -> None:
+        """3a: springs, failure, broken-pair contact (after it, pair_mode holds this step's failures)."""
+        launch_spring_forces(self.model, state, dt, t)
+
+    def forces_rest(self, state: State, dt: float, t: float) -> None:
+        """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode)."""
         launch_element_forces(self.model, state, dt)              # 3b CST stress update, f = f_int
         launch_gather_springs(self.model, state)                  # 3c f += spring forces (gather)
         self.set_pulses(state, t)

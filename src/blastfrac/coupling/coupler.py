@@ -17,7 +17,8 @@ import warp as wp
 
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
 from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, accumulate_gas_contact_work,
-                              accumulate_rock_contact_work, collect_exposed_elements, eval_particle_edge_contact)
+                              accumulate_rock_contact_work, add_node_loads, collect_exposed_elements,
+                              eval_particle_edge_contact)
 
 
 def default_contact_stiffness(p_cj: float, factor: float = 20.0) -> float:
@@ -132,8 +133,10 @@ class GasRockCoupler:
         self._since = 0
 
     def apply(self, state, dt: float) -> None:
-        """Contact forces at the current positions: f_ext_p and f_ext_moment of the gas (assigned) and rock reactions
-        (added to state.f), and the work bookkeeping (``_account_work``)."""
+        """Contact forces at the current positions: f_ext_p and f_ext_moment of the gas (assigned) and the rock
+        reactions (into f_react; ``add_reactions`` adds them to state.f), and the work bookkeeping
+        (``_account_work``). Reads state.x, state.v and state.pair_mode only, so it may run beside the rock's
+        force stages once the springs have failed for this step."""
         if self._since >= self.rebuild_interval:
             self._rebuild(state)
         self._since += 1
@@ -154,10 +157,14 @@ class GasRockCoupler:
                           wp.float64(self.query_radius), wp.float64(dt),
                           wp.float64(float(self.surface_forces)), wp.float64(float(self.pressure_preload)),
                           *self._hist[0]],
-                  outputs=[mpm.f_ext_p, mpm.f_ext_moment, state.f, self.f_react, self.acc, *self._hist[1]],
+                  outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1]],
                   device=m.device)
         self._hist.reverse()
         self._account_work(state, dt)                      # this step's forces, velocities before the step
+
+    def add_reactions(self, state) -> None:
+        """state.f += this step's contact reactions (f_react)."""
+        wp.launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_react], device=self.model.device)
 
     def _account_work(self, state, dt: float) -> None:
         """Add ½dt of the work of the current contact forces to the absorbed energy, with the present velocities.

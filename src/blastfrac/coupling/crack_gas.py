@@ -163,6 +163,7 @@ class CrackGas:
         self.particle_size = float(mpm.spec.h / mpm.opts.ppc) if mpm is not None else 0.0
         self._released = wp.zeros(1, dtype=wp.int32, device=d)
         self.released_cells = 0
+        self.f_nodes = wp.zeros(max(1, model.node_count), dtype=wp.vec2d, device=d)   # this step's face loads [N/m]
         self.n_links = 0
         self.n_mouths = 0
         self._since = self.rebuild_interval
@@ -199,15 +200,16 @@ class CrackGas:
         self._since = 0
 
     def apply(self, state, dt: float) -> None:
-        """Stage between the particle–edge contact and P2G: cell pressures and face forces (added to state.f),
-        then this step's flow along the network and at the mouths."""
+        """Stage between the particle–edge contact and P2G: cell pressures and face forces (into f_nodes;
+        ``add_loads`` adds them to state.f), then this step's flow along the network and at the mouths."""
         m, d = self.model, self.device
         if self._since >= self.rebuild_interval:
             self.rebuild(state)
         self._since += 1
+        self.f_nodes.zero_()
         wp.launch(update_crack_cells, dim=self.Q,
                   inputs=[self.cells, self.gas, self.params, state.pair_mode, state.x, state.v,
-                          wp.float64(self._dt_prev), wp.float64(dt), state.f], device=d)
+                          wp.float64(self._dt_prev), wp.float64(dt), self.f_nodes], device=d)
         self._dt_prev = dt
         n = self.n_links + self.n_mouths
         if n == 0:
@@ -220,6 +222,12 @@ class CrackGas:
         wp.launch(crack_apply_flux, dim=n, inputs=[self.links, self.gas, self.parts], device=d)
         if self.n_mouths:
             wp.launch(crack_refresh_particles, dim=self.n_particles, inputs=[self.parts, self.params], device=d)
+
+    def add_loads(self, state) -> None:
+        """state.f += this step's crack-face loads."""
+        from .kernels_contact import add_node_loads
+
+        wp.launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_nodes], device=self.device)
 
     # ------------------------------------------------------------------ verification hooks
     def set_cell_state(self, cells, mass, energy) -> None:

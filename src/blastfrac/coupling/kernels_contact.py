@@ -90,14 +90,14 @@ def eval_particle_edge_contact(
     hist_x_in: wp.array(dtype=wp.float64),
     f_p: wp.array(dtype=wp.vec2d),
     fm_p: wp.array(dtype=wp.mat22d),
-    f_rock: wp.array(dtype=wp.vec2d),
     f_react: wp.array(dtype=wp.vec2d),
     acc: wp.array(dtype=wp.float64),
     hist_e_out: wp.array(dtype=wp.int32),
     hist_d_out: wp.array(dtype=wp.float64),
     hist_x_out: wp.array(dtype=wp.float64),
 ):
-    """Contact force on each particle (assigned to f_p) and its reactions (added to f_rock), METHOD §3.
+    """Contact force on each particle (assigned to f_p) and its reactions on the rock nodes (added to f_react,
+    which the step adds to the rock's forces: coupler.add_reactions), METHOD §3.
 
     points, elem_reach: the listed elements' centroids at the last rebuild [m] and their reach [m] (per element).
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
@@ -198,8 +198,6 @@ def eval_particle_edge_contact(
             f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
             fsum = fsum + f
             msum = msum + wp.outer(f, arm)
-            wp.atomic_add(f_rock, ia, -wa * f)
-            wp.atomic_add(f_rock, ib, -bxi * f)
             wp.atomic_add(f_react, ia, -wa * f)
             wp.atomic_add(f_react, ib, -bxi * f)
             stored = stored + wp.float64(0.5) * kc * best * best
@@ -246,3 +244,10 @@ def accumulate_rock_contact_work(
     f = f_react[i]
     if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
         wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(f, v[i]))
+
+
+@wp.kernel
+def add_node_loads(f: wp.array(dtype=wp.vec2d), a: wp.array(dtype=wp.vec2d)):
+    """f += a [N/m] (the gas loads on the rock nodes, added after the rock's own forces in a fixed order)."""
+    i = wp.tid()
+    f[i] = f[i] + a[i]

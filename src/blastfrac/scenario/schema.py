@@ -43,6 +43,13 @@ class SimulationConfig(_Strict):
     seed: int = Field(0, ge=0, le=2**31 - 1, description="Seed of gmsh's random factor and of any random field. The gmsh Delaunay mesh does not change with it (measured: seeds 0, 1, 2 give identical meshes); for another mesh realisation change a mesh size by about 1 % (examples/confined_blast/mesh_study.md).")
     max_steps: int | None = Field(None, gt=0, description="Stop after this many steps even before end_time.")
     progress: bool = Field(True, description="Show a progress bar on the terminal.")
+    threads: int = Field(
+        1, ge=1, le=2, description="CPU threads of a coupled step [-]: 2 runs the gas stages (particle–edge "
+        "contact, crack gas, P2G, grid, G2P, EOS) beside the rock's (CST, loads, block contact, integration) in a "
+        "second Python thread (Warp's CPU kernels release the GIL); results are the same as with 1 (tests/unit/"
+        "test_threads.py). Default 1 (benchmarks/RESULTS.md).",
+    )
+
 
 
 # --------------------------------------------------------------------------- output
