@@ -572,11 +572,12 @@ class Simulation:
     def _check_budget(self, err: float, rel: float, final: bool = False) -> None:
         """Warn once (stderr and summary.json → warnings) when |budget_error_relative| > output.budget_warning.
 
-        Samples of the first ``_BUDGET_MIN_STEPS`` steps are not checked (the work sums lag the state by one
-        step, a large fraction of the tiny energies at the start); the final state always is.
+        Samples of the first ``_BUDGET_MIN_STEPS`` steps are not checked, not even the final one of so short a run
+        (the work sums lag the state by one step, a large fraction of the tiny energies at the start); the final
+        state of a longer run always is.
         """
         limit = self.scenario.output.budget_warning
-        if self._budget_warned or not abs(rel) > limit or (self.steps < _BUDGET_MIN_STEPS and not final):
+        if self._budget_warned or not abs(rel) > limit or self.steps < _BUDGET_MIN_STEPS:
             return
         self._budget_warned = True
         msg = (f"energy budget error {rel * 100:+.1f} % ({err:.4g} J/m) at step {self.steps} (t = {self.time:.4e} s) "

@@ -166,13 +166,20 @@ def test_budget_warning_option_is_validated(tmp_path):
 
 def test_budget_warning_once_on_stderr_and_in_summary(tmp_path, capsys):
     sc = scenario_from_dict(_scenario(tmp_path, output={"budget_warning": 1e-14}))
-    sim = Simulation(sc, max_steps=40)
+    sim = Simulation(sc, max_steps=60)                  # past the 50 steps before which no sample is checked
     s = sim.run(progress=False)
     err = capsys.readouterr().err
     assert err.count("warning: energy budget error") == 1 and "output.budget_warning" in err
     written = _strict_loads((sim.out_dir / "summary.json").read_text())
     assert len(written["warnings"]) == 1 and "energy budget error" in written["warnings"][0]
     assert abs(written["energy"]["budget_error_relative"]) > 1e-14 or len(s["warnings"]) == 1
+
+
+def test_no_budget_warning_for_a_run_shorter_than_the_check_window(tmp_path, capsys):
+    """A 2-step run warned of a +100 % error in its 6e-6 J/m: the final state of so short a run is not checked."""
+    sim = Simulation(scenario_from_dict(_scenario(tmp_path, output={"budget_warning": 1e-14})), max_steps=2)
+    s = sim.run(progress=False)
+    assert s["warnings"] == [] and "energy budget" not in capsys.readouterr().err
 
 
 def test_budget_warning_follows_the_final_error(tmp_path, initial_insitu_run, capsys):

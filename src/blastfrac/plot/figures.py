@@ -285,7 +285,8 @@ def fragment_sizes(path: Path, size: np.ndarray, area: np.ndarray, blasted: np.n
     ax.set_ylabel("passing (area = mass fraction finer) [%]")
     ax.set_ylim(0, 100)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, loc="upper left")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=7, loc="upper left")
     ax.set_title(textwrap.fill(title or "Fragment sizes (fragments not touching the outer boundary; single blocks "
                                         "are at the mesh scale)", 90), fontsize=9)
     fig.tight_layout()
