@@ -301,24 +301,33 @@ def ppv_map(path: Path, X: np.ndarray, ppv: np.ndarray, centres: list, vib: dict
     from matplotlib.collections import PolyCollection
     from matplotlib.colors import LogNorm
 
-    fig, ax = plt.subplots(figsize=(7, 6), dpi=150)
+    span = np.ptp(X, axis=0)
+    aspect = float(span[1] / max(span[0], 1e-300))
+    fig, ax = plt.subplots(figsize=(7.5, max(2.8, min(7.0, 6.3 * aspect + 1.2))), dpi=150)
     tri = X.reshape(-1, 3, 2)
     val = np.maximum(ppv.reshape(-1, 3).mean(axis=1), 1e-3)
     crit = vib["ppv_critical"]
     pc = PolyCollection(tri, array=val, cmap="viridis", norm=LogNorm(vmin=max(val.min(), 1e-2), vmax=val.max()),
                         edgecolors="none")
     ax.add_collection(pc)
-    fig.colorbar(pc, ax=ax, label="peak particle velocity [m/s]")
+    ax.set_xlim(X[:, 0].min(), X[:, 0].max())
+    ax.set_ylim(X[:, 1].min(), X[:, 1].max())
+    ax.set_aspect("equal")
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
+
+    cax = make_axes_locatable(ax).append_axes("right", size="3%", pad=0.08)     # as tall as the map
+    fig.colorbar(pc, cax=cax, label="peak particle velocity [m/s]")
     rd = vib.get("damage_radius")
     th = np.linspace(0, 2 * np.pi, 200)
-    for (c, r) in centres:
-        if rd is not None and np.isfinite(rd):
+    if rd is not None and np.isfinite(rd) and not vib.get("damage_beyond_model"):
+        for (c, r) in centres:
             ax.plot(c[0] + rd * np.cos(th), c[1] + rd * np.sin(th), color="w", lw=1.2, ls="--")
-    if rd is not None and np.isfinite(rd):
-        edge = " ≥, to the model's edge" if vib.get("damage_beyond_model") else ""
-        ax.plot([], [], color="k", ls="--", label=f"damage radius{edge} {rd * 1e3:.0f} mm (PPV > PPV_crit = σ_t c_p/E "
+        ax.plot([], [], color="k", ls="--", label=f"damage radius {rd * 1e3:.0f} mm (PPV > PPV_crit = σ_t c_p/E "
                                                    f"= {crit:.1f} m/s)")
         ax.legend(fontsize=7, loc="upper right")
+    elif rd is not None and np.isfinite(rd):
+        ax.text(0.01, 0.99, f"PPV > PPV_crit = σ_t c_p/E = {crit:.2g} m/s up to the model's edge", fontsize=7,
+                va="top", transform=ax.transAxes, color="w")
     ax.set_xlim(X[:, 0].min(), X[:, 0].max())
     ax.set_ylim(X[:, 1].min(), X[:, 1].max())
     ax.set_aspect("equal")
