@@ -72,12 +72,33 @@ carried overlap smaller, friction spring reset) go to energy_acc[CONTACT_DISSIPA
 still closes; ``BlockContact.losses()`` keeps them apart and ``stored_energy()`` gives the energy held by
 active contacts.
 
-**Cost.** One thread per node; a node with no exposed edge leaves after two loads, and the search itself is a
-function so that those nodes do not pay for its locals. The hash holds sample points of every edge (rebuilt
-every 10 steps); an open node that found nothing within h_min skips the next 10 searches (the same speed
-bound as the rebuild). On 59k elements (CPU): ×1.35 per step on nearly intact rock, ×2.9 with 17 % of the
-springs broken (the vertex-fan search of held broken faces; ×1.4 with ``held_faces`` off, at the price of
-0.3·h overlaps in the crushed zone).
+**Cost.** The hash holds sample points of every edge (rebuilt every 10 steps); an open node that found nothing
+within h_min skips the next 10 searches (the same speed bound as the rebuild). Held broken faces, the bulk of a
+crushed zone, would make every step cost what its cracking made (7,000 of 11,900 nodes walking their fan at the
+end of the demo), so the pass works from caches that change only when a spring does (``BlockContact.fan_cache``):
+
+- per node, its tributary length and open flag, its fan_exclusions mask and its fan candidates: the nodes at its
+  vertex of other blocks, not excluded, with an exposed edge there (at most FAN_CACHE; more: walk the fan). They
+  depend on spring states only; mark_pair_changes compares those with the last step's and refresh_fan_cache
+  rebuilds the caches of the nodes at both vertices of a changed spring's interface;
+- select_contact_nodes lists the nodes the contact pass has anything to do for, from the caches: a held node
+  without contact only if one of its candidates passes the corner sign test and one of that corner's exposed
+  edges may pass consider_edge (edge_may_take, a conservative ξ and wedge test). At the demo's end ~200 of
+  ~5,000 such nodes are listed. eval_block_contact runs over the list in node order and makes every decision
+  again, so the result is that of one pass over all nodes, to the last bit on a CPU;
+- the hash is a cell grid of our own with the cells and the point order of wp.HashGrid (the same points met in the
+  same order), each cell's points stored together with the exposure of their edge (kept by mark_pair_changes):
+  a query reads memory in sequence and loads no spring state;
+- the launches are recorded once and replayed (``BlockContact._launch``): packing ~50 arguments costs more than a
+  pass over the nodes of a small mesh.
+
+With ``fan_cache`` off every node is evaluated as before (wp.HashGrid, every held node walks its fan; ~15 %
+slower than the code before the cache, a reference only). Demo end state (3,966 blocks, 36 % of the springs
+broken, benchmarks/contact_cache.py, CPU): the rock step costs ×2.1–2.8 the intact one (×3.6–4.1 before the
+cache, the intact step unchanged); what is left is mostly the contact of ~1,200 held nodes in contact and the
+hash search of ~300 open ones. Before the cache, on 59k elements (CPU): ×1.35 per step on nearly intact rock,
+×2.9 with 17 % of the springs broken (×1.4 with ``held_faces`` off, at the price of 0.3·h overlaps in the
+crushed zone).
 
 **Stable step** (METHOD §1.7). ModelBuilder doubles the spring row sums of a breakable model, an allowance
 of 2·K_c per contact with K_c = kn·A_node of a node whose edges are all exposed (the springs of those edges
@@ -98,8 +119,10 @@ from ..model.model import CONTACT_DISSIPATED
 XI_TOL = wp.constant(wp.float64(1.0e-9))     # ξ range tolerance: a node exactly at an edge's end (flush corners)
 WEDGE_TOL = wp.constant(wp.float64(0.01))    # sine of the least angle (0.6°) the node's element must face the edge
 vec5d = wp.types.vector(length=5, dtype=wp.float64)
+vec6d = wp.types.vector(length=6, dtype=wp.float64)
 MAX_FAN = wp.constant(64)                     # bound on the pairs walked around one vertex (a fan has ~6)
 KC_CAP = wp.constant(wp.float64(0.25))        # Kc ≤ KC_CAP·m_min/Δt²: ω_c·Δt ≤ 0.71, node against edge
+FAN_CACHE = wp.constant(8)                    # cached fan candidates of a node (≤ 4 seen in the demo; more: walk)
 
 LOSS_SLIP = 0          # BlockContact.loss_acc slots: Coulomb slip work [J/m]
 LOSS_PENALTY = 1       # penalty and tangential elastic energy dropped when a contact ends or changes edge [J/m]
@@ -335,39 +358,592 @@ def compute_edge_samples(
 
 
 @wp.func
-def contact_node(
-    n: wp.int32,
-    trib: wp.float64,
-    grid: wp.uint64,
-    points: wp.array(dtype=wp.vec3d),
+def cell_coord(v: wp.float64):
+    """Cell coordinate of a scaled position, as wp.HashGrid computes it (floor, clamped to the int range)."""
+    c = wp.floor(v)
+    out = wp.int32(0)                                 # NaN
+    if c >= wp.float64(2147483646.0):
+        out = wp.int32(2147483646)
+    elif c >= wp.float64(-2147483648.0):
+        out = wp.int32(c)
+    elif c < wp.float64(-2147483648.0):
+        out = wp.int32(-2147483647) - wp.int32(1)
+    return out
+
+
+@wp.func
+def cell_wrap(c: wp.int32, dim: wp.int32):
+    """Physical cell of virtual cell coordinate c: non-negative modulo, as wp.HashGrid."""
+    r = c
+    if r < 0 or r >= dim:
+        r = c % dim
+        if r < 0:
+            r = r + dim
+    return r
+
+
+@wp.func
+def cell_end(start: wp.int32, end: wp.int32, dim: wp.int32):
+    """Last cell coordinate of a query, at most one pass over a dimension (as wp.HashGrid)."""
+    out = end
+    if wp.int64(end) - wp.int64(start) >= wp.int64(dim):
+        out = start + (dim - 1)
+    return out
+
+
+@wp.kernel
+def compute_sample_cells(
+    x: wp.array(dtype=wp.vec2d),
     sample_slot: wp.array(dtype=wp.int32),
+    sample_frac: wp.array(dtype=wp.float64),
     slot_iface: wp.array(dtype=wp.int32),
-    slot_l0: wp.array(dtype=wp.float64),
+    pair_mode: wp.array(dtype=wp.int32),
+    cell_inv: wp.float64,
+    dim: wp.int32,
+    sample_xy: wp.array(dtype=wp.vec2d),
+    sample_code: wp.array(dtype=wp.int32),
+    keys: wp.array(dtype=wp.int32),
+    values: wp.array(dtype=wp.int32),
+):
+    """Hash points of the cell grid (BlockContact "Hash"): the same points as compute_edge_samples, their code
+    (slot + 1 on an exposed edge, −(slot + 1) on another) and their cell (its row-major index, the cell
+    wp.HashGrid puts them in) for the sort."""
+    i = wp.tid()
+    s = sample_slot[i]
+    xa = x[s]
+    m = xa + sample_frac[i] * (x[slot_end(s)] - xa)
+    sample_xy[i] = m
+    code = -(s + 1)
+    if slot_exposed(s, slot_iface, pair_mode):
+        code = s + 1
+    sample_code[i] = code
+    keys[i] = cell_wrap(cell_coord(m[1] * cell_inv), dim) * dim + cell_wrap(cell_coord(m[0] * cell_inv), dim)
+    values[i] = i
+
+
+@wp.kernel
+def gather_sample_cells(
+    keys: wp.array(dtype=wp.int32),
+    values: wp.array(dtype=wp.int32),
+    count: wp.int32,
+    sample_xy: wp.array(dtype=wp.vec2d),
+    sample_code: wp.array(dtype=wp.int32),
+    cell_starts: wp.array(dtype=wp.int32),
+    cell_ends: wp.array(dtype=wp.int32),
+    sorted_xy: wp.array(dtype=wp.vec2d),
+    sorted_code: wp.array(dtype=wp.int32),
+    sample_pos: wp.array(dtype=wp.int32),
+):
+    """After the (stable) sort by cell: each cell's range and its points in order, stored contiguously, with
+    their codes (mark_pair_changes keeps the sign of sorted_code up to date)."""
+    j = wp.tid()
+    c = keys[j]
+    i = values[j]
+    sorted_xy[j] = sample_xy[i]
+    sorted_code[j] = sample_code[i]
+    sample_pos[i] = j
+    if j == 0:
+        cell_starts[c] = j
+    elif keys[j - 1] != c:
+        cell_starts[c] = j
+    if j == count - 1:
+        cell_ends[c] = j + 1
+    elif keys[j + 1] != c:
+        cell_ends[c] = j + 1
+
+
+@wp.func
+def corner_inside(
+    xn: wp.vec2d, other: wp.int32, ex1: bool, ex2: bool, x: wp.array(dtype=wp.vec2d), touch_tol: wp.float64,
+):
+    """True if xn is behind both exposed edges of other's element at other's vertex (within touch_tol): the
+    cheap sign test of the held-face search, done before the full evaluation (module doc, "Cost")."""
+    zero = wp.float64(0.0)
+    sb = slot_prev(other)
+    xc = x[other]
+    t1 = x[slot_end(other)] - xc
+    t2 = xc - x[sb]
+    r1 = xn - xc
+    r2 = xn - x[sb]
+    c1 = t1[1] * r1[0] - t1[0] * r1[1]
+    c2 = t2[1] * r2[0] - t2[0] * r2[1]
+    tol2 = touch_tol * touch_tol
+    inside1 = (not ex1) or c1 <= zero or c1 * c1 <= tol2 * wp.dot(t1, t1)
+    inside2 = (not ex2) or c2 <= zero or c2 * c2 <= tol2 * wp.dot(t2, t2)
+    return inside1 and inside2
+
+
+@wp.func
+def edge_may_take(xn: wp.vec2d, xa: wp.vec2d, xb: wp.vec2d, e1: wp.vec2d, e2: wp.vec2d):
+    """False only if consider_edge certainly rejects edge a→b for a node at xn whose element's edges at the node
+    are e1, e2 (not normalised): xn projects outside the edge (ξ beyond XI_TOL) or the node's element faces away
+    from it (wedge test). Without square roots or divisions; its margins (1e-12 of |r|·|ab|, 1e-6 of the wedge
+    threshold) are far above the round-off of either form, so it never rejects what consider_edge would take."""
+    ab = xb - xa
+    r = xn - xa
+    l2 = wp.dot(ab, ab)
+    slack = wp.float64(1.0e-12) * (wp.dot(r, r) + l2)           # ≥ 1e-12·|r|·|ab|
+    d = wp.dot(r, ab)                                            # ξ·|ab|²
+    if d < -XI_TOL * l2 - slack or d > (wp.float64(1.0) + XI_TOL) * l2 + slack:
+        return False
+    nrm = wp.vec2d(ab[1], -ab[0])                                # outward normal times |ab|
+    w2 = WEDGE_TOL * WEDGE_TOL * (wp.float64(1.0) - wp.float64(1.0e-6)) * l2
+    w1 = wp.dot(e1, nrm)
+    if w1 > wp.float64(0.0) and w1 * w1 > w2 * wp.dot(e1, e1):
+        return True
+    w = wp.dot(e2, nrm)
+    return w > wp.float64(0.0) and w * w > w2 * wp.dot(e2, e2)
+
+
+@wp.func
+def corner_consider(
+    other: wp.int32, ex1: bool, ex2: bool, xn: wp.vec2d, u1: wp.vec2d, u2: wp.vec2d,
+    x: wp.array(dtype=wp.vec2d), slot_iface: wp.array(dtype=wp.int32), pair_mode: wp.array(dtype=wp.int32),
+    st: vec5d, max_depth: wp.float64, touch_tol: wp.float64,
+):
+    """consider_edge for the exposed edges of other's element at the vertex (a node inside that corner)."""
+    sb = slot_prev(other)
+    xc = x[other]
+    out = st
+    if ex1:
+        out = consider_edge(other, edge_coords(xn, xc, x[slot_end(other)]), sb, xn, u1, u2,
+                            x, slot_iface, pair_mode, out, max_depth, touch_tol)
+    if ex2:
+        out = consider_edge(sb, edge_coords(xn, x[sb], xc), other, xn, u1, u2, x,
+                            slot_iface, pair_mode, out, max_depth, touch_tol)
+    return out
+
+
+@wp.func
+def fan_cache_build(
+    n: wp.int32,
+    excl: wp.int64,
     node_vertex: wp.array(dtype=wp.int32),
     vertex_start: wp.array(dtype=wp.int32),
     vertex_nodes: wp.array(dtype=wp.int32),
     fan_index: wp.array(dtype=wp.int32),
-    node_mass: wp.array(dtype=wp.float64),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+):
+    """Cache the fan candidates of node n: the nodes at its vertex, in vertex order, of another element, not in
+    its exclusion mask excl and with an exposed edge at the vertex, as 4·node + (1 if its edge 'node' is
+    exposed) + (2 if its edge ending at the node is); fan_count −1 if more than FAN_CACHE (walk the fan)."""
+    e = n // 3
+    vtx = node_vertex[n]
+    k = wp.int32(0)
+    for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+        other = vertex_nodes[j]
+        if other // 3 != e:
+            if not in_mask(excl, other, fan_index):
+                code = wp.int32(0)
+                if slot_exposed(other, slot_iface, pair_mode):
+                    code = code + 1
+                if slot_exposed(slot_prev(other), slot_iface, pair_mode):
+                    code = code + 2
+                if code != 0:
+                    if k < FAN_CACHE:
+                        fan_cand[n, k] = 4 * other + code
+                    k = k + 1
+    if k > FAN_CACHE:
+        k = wp.int32(-1)
+    fan_count[n] = k
+
+
+@wp.func
+def held_search(
+    n: wp.int32,
+    excl: wp.int64,
+    use_cache: wp.int32,
+    node_vertex: wp.array(dtype=wp.int32),
+    vertex_start: wp.array(dtype=wp.int32),
+    vertex_nodes: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    max_depth: wp.float64,
+    touch_tol: wp.float64,
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+):
+    """Search state (consider_edge) of held node n: the other blocks at its own vertex only (module doc). With
+    use_cache, over its cached fan candidates (fan_cache_build: the same nodes in the same order, so the same
+    result); otherwise, or if the fan overflowed the cache, by walking the vertex's node list."""
+    e = n // 3
+    zero = wp.float64(0.0)
+    xn = x[n]
+    st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
+    # the node's element wedge (unit vectors along its two edges at the node), only once a corner test passes
+    have_u = bool(False)
+    u1 = wp.vec2d(zero, zero)
+    u2 = wp.vec2d(zero, zero)
+    cnt = wp.int32(-1)
+    if use_cache != 0:
+        cnt = fan_count[n]
+    if cnt >= 0:
+        for k in range(cnt):
+            code = fan_cand[n, k]
+            other = code >> 2
+            ex1 = (code & 1) != 0
+            ex2 = (code & 2) != 0
+            if corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                if not have_u:
+                    u1 = wp.normalize(x[slot_end(n)] - xn)
+                    u2 = wp.normalize(x[slot_prev(n)] - xn)
+                    have_u = True
+                st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st, max_depth, touch_tol)
+    else:
+        vtx = node_vertex[n]
+        for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+            other = vertex_nodes[j]
+            if other // 3 != e:
+                if not in_mask(excl, other, fan_index):
+                    ex1 = slot_exposed(other, slot_iface, pair_mode)
+                    ex2 = slot_exposed(slot_prev(other), slot_iface, pair_mode)
+                    # only a node inside the corner (behind both exposed edges) can be a contact: a cheap sign
+                    # test first, the full evaluation for the few that pass
+                    if ex1 or ex2:
+                        if corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                            if not have_u:
+                                u1 = wp.normalize(x[slot_end(n)] - xn)
+                                u2 = wp.normalize(x[slot_prev(n)] - xn)
+                                have_u = True
+                            st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st,
+                                                 max_depth, touch_tol)
+    return st
+
+
+@wp.kernel
+def mark_pair_changes(
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+    pair_vertex: wp.array(dtype=wp.int32),
+    step: wp.int32,
+    seen_mode: wp.array(dtype=wp.int32),
+    seen_dropped: wp.array(dtype=wp.int32),
+    vertex_stamp: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    dirty_vertices: wp.array(dtype=wp.int32),
+    iface_slots: wp.array(dtype=wp.vec2i),
+    slot_samples: wp.array(dtype=wp.vec2i),
+    sample_pos: wp.array(dtype=wp.int32),
+    sorted_code: wp.array(dtype=wp.int32),
+):
+    """List (once each, counts[0] of them) the vertices whose fan caches a change of spring p's state since the
+    last call makes stale: both ends of p's interface (the exposure of its edges counts at both vertices, the
+    exclusion chains at p's own); and the sorted_code sign of the hash points on the interface's two edges."""
+    p = wp.tid()
+    mode = pair_mode[p]
+    dropped = pair_dropped[p]
+    if mode != seen_mode[p] or dropped != seen_dropped[p]:
+        seen_mode[p] = mode
+        seen_dropped[p] = dropped
+        q = p // 2
+        for k in range(2):
+            vtx = pair_vertex[2 * q + k]
+            if wp.atomic_exch(vertex_stamp, vtx, step) != step:
+                dirty_vertices[wp.atomic_add(counts, 0, 1)] = vtx
+        exposed = pair_mode[2 * q] != 0 and pair_mode[2 * q + 1] != 0
+        for k in range(2):
+            sl = iface_slots[q][k]
+            code = -(sl + 1)
+            if exposed:
+                code = sl + 1
+            rng = slot_samples[sl]
+            for i in range(rng[0], rng[0] + rng[1]):
+                sorted_code[sample_pos[i]] = code
+
+
+@wp.func
+def node_faces(
+    n: wp.int32,
+    slot_iface: wp.array(dtype=wp.int32),
+    slot_l0: wp.array(dtype=wp.float64),
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+):
+    """(tributary length [m], 1 if open) of node n. The tributary length is half of each exposed edge of the
+    node's own element at the node; 0: not a candidate (edges only ever become exposed, so such a node never
+    had a contact). Open: one of those edges is a mesh-boundary edge or an interface with a dropped pair."""
+    zero = wp.float64(0.0)
+    half = wp.float64(0.5)
+    sp = slot_prev(n)
+    trib = zero
+    if slot_exposed(n, slot_iface, pair_mode):
+        trib = trib + half * slot_l0[n]
+    if slot_exposed(sp, slot_iface, pair_mode):
+        trib = trib + half * slot_l0[sp]
+    is_open = zero
+    if trib != zero:
+        if slot_open(n, slot_iface, pair_dropped) or slot_open(sp, slot_iface, pair_dropped):
+            is_open = wp.float64(1.0)
+    return wp.vec2d(trib, is_open)
+
+
+@wp.func
+def node_woken(e: wp.int32, elem_near: wp.array(dtype=wp.int32), step: wp.int32, near_window: wp.int32):
+    """True if an open face came near element e in the last near_window steps. Flags set in this step are not
+    read until the next one (a block woken again earlier in this step's pass reads as not woken)."""
+    return elem_near[e] >= step - near_window and elem_near[e] < step
+
+
+@wp.kernel
+def refresh_fan_cache(
+    refresh_all: wp.int32,
+    counts: wp.array(dtype=wp.int32),
+    dirty_vertices: wp.array(dtype=wp.int32),
+    node_vertex: wp.array(dtype=wp.int32),
+    vertex_start: wp.array(dtype=wp.int32),
+    vertex_nodes: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    slot_l0: wp.array(dtype=wp.float64),
     node_pairs: wp.array(dtype=wp.vec2i),
     pair_i: wp.array(dtype=wp.int32),
     pair_j: wp.array(dtype=wp.int32),
     pair_mode: wp.array(dtype=wp.int32),
     pair_dropped: wp.array(dtype=wp.int32),
+    node_face: wp.array(dtype=wp.vec2d),
+    node_flag: wp.array(dtype=wp.int32),
+    fan_excl: wp.array(dtype=wp.int64),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+):
+    """Rebuild the caches (node_faces and node_flag, fan_exclusions mask, fan_cache_build list) of every node at
+    a listed vertex (every vertex with refresh_all): each thread writes only its own vertex's nodes, from the
+    spring states, so the order of the threads does not matter."""
+    i = wp.tid()
+    vtx = i
+    if refresh_all == 0:
+        if i >= counts[0]:
+            return
+        vtx = dirty_vertices[i]
+    for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+        n = vertex_nodes[j]
+        nf = node_faces(n, slot_iface, slot_l0, pair_mode, pair_dropped)
+        node_face[n] = nf
+        flag = wp.int32(0)                        # 0 no exposed edge, 1 held, 2 open
+        if nf[0] != wp.float64(0.0):
+            flag = 1
+            if nf[1] != wp.float64(0.0):
+                flag = 2
+        node_flag[n] = flag
+        ex = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
+        fan_excl[n] = ex
+        fan_cache_build(n, ex, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface, pair_mode,
+                        fan_cand, fan_count)
+
+
+@wp.kernel
+def list_candidates(node_flag: wp.array(dtype=wp.int32), cand_count: wp.array(dtype=wp.int32),
+                    cand_list: wp.array(dtype=wp.int32)):
+    """The nodes with an exposed edge at them (node_flag ≠ 0), in node order on a CPU: select_contact_nodes runs
+    over them only. Rebuilt when refresh_fan_cache has changed a flag."""
+    n = wp.tid()
+    if node_flag[n] != 0:
+        cand_list[wp.atomic_add(cand_count, 0, 1)] = n
+
+
+@wp.kernel
+def select_contact_nodes(
+    cand_list: wp.array(dtype=wp.int32),
+    cand_count: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
-    v: wp.array(dtype=wp.vec2d),
-    kn_area: wp.float64,
-    mu_f: wp.float64,
+    touch_tol: wp.float64,
+    step: wp.int32,
+    near_window: wp.int32,
+    held_faces: wp.int32,
+    elem_near: wp.array(dtype=wp.int32),
+    query_after: wp.array(dtype=wp.int32),
+    contact_slot: wp.array(dtype=wp.int32),
+    node_flag: wp.array(dtype=wp.int32),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    node_list: wp.array(dtype=wp.int32),
+):
+    """List (counts[1] of them, in node order on a CPU) the nodes of cand_list eval_block_contact has anything
+    to do for; it would leave the others without a write (from the caches: node_flag, fan candidates). A held node without
+    contact is listed only if one of its fan candidates passes the corner sign test (held_search makes the same
+    test first and finds nothing otherwise) and one of that corner's exposed edges passes edge_may_take."""
+    i = wp.tid()
+    if i >= cand_count[0]:
+        return
+    n = cand_list[i]
+    flag = node_flag[n]
+    if flag == 0:
+        return
+    is_open = flag == 2
+    woken = node_woken(n // 3, elem_near, step, near_window)
+    if not (is_open or woken):
+        if contact_slot[n] < 0:
+            if held_faces == 0:
+                return                            # held broken faces not searched (BlockContact.held_faces)
+            cnt = fan_count[n]
+            if cnt >= 0:
+                xn = x[n]
+                hit = bool(False)
+                for k in range(cnt):
+                    code = fan_cand[n, k]
+                    other = code >> 2
+                    ex1 = (code & 1) != 0
+                    ex2 = (code & 2) != 0
+                    if not hit and corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                        # the corner's exposed edges: can consider_edge take either? (edge_may_take)
+                        e1 = x[slot_end(n)] - xn
+                        e2 = x[slot_prev(n)] - xn
+                        xc = x[other]
+                        sb = slot_prev(other)
+                        if ex1:
+                            hit = edge_may_take(xn, xc, x[slot_end(other)], e1, e2)
+                        if ex2 and not hit:
+                            hit = edge_may_take(xn, x[sb], xc, e1, e2)
+                if not hit:
+                    return
+    # an open node whose last search found nothing within reach skips the search (BlockContact doc)
+    elif is_open and not woken and step < query_after[n] and contact_slot[n] < 0:
+        return
+    node_list[wp.atomic_add(counts, 1, 1)] = n
+
+
+@wp.func
+def hash_edge(
+    s: wp.int32,
+    xn: wp.vec2d,
+    u1: wp.vec2d,
+    u2: wp.vec2d,
+    vtx: wp.int32,
+    excl: wp.int64,
+    is_open: bool,
+    node_vertex: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    max_depth: wp.float64,
+    touch_tol: wp.float64,
+    wake_dist: wp.float64,
+    step: wp.int32,
+    elem_near: wp.array(dtype=wp.int32),
+    sr: vec6d,
+):
+    """hash_search for one exposed edge s of another element within the search radius: sr = (search state of
+    consider_edge, distance to the closest edge). Wakes the edge's block if an open face comes near it."""
+    s_end = slot_end(s)
+    skip = bool(False)
+    corner = wp.int32(-1)
+    if node_vertex[s] == vtx:
+        skip = in_mask(excl, s, fan_index)
+        corner = slot_prev(s)
+    elif node_vertex[s_end] == vtx:
+        skip = in_mask(excl, s_end, fan_index)
+        corner = s_end
+    out = sr
+    if not skip:
+        c = edge_coords(xn, x[s], x[s_end])
+        st = consider_edge(s, c, corner, xn, u1, u2, x, slot_iface, pair_mode,
+                           vec5d(sr[0], sr[1], sr[2], sr[3], sr[4]), max_depth, touch_tol)
+        out = vec6d(st[0], st[1], st[2], st[3], st[4], wp.min(sr[5], c[2]))
+        if is_open and c[2] < wake_dist:
+            elem_near[s // 3] = step          # wake the block this open face comes near
+    return out
+
+
+@wp.func
+def hash_search(
+    n: wp.int32,
+    is_open: bool,
+    excl: wp.int64,
+    use_cache: wp.int32,
+    grid: wp.uint64,
+    points: wp.array(dtype=wp.vec3d),
+    sample_slot: wp.array(dtype=wp.int32),
+    cell_inv: wp.float64,
+    cell_dim: wp.int32,
+    cell_starts: wp.array(dtype=wp.int32),
+    cell_ends: wp.array(dtype=wp.int32),
+    sorted_xy: wp.array(dtype=wp.vec2d),
+    sorted_code: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    node_vertex: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
     search_radius: wp.float64,
     max_depth: wp.float64,
     touch_tol: wp.float64,
     wake_dist: wp.float64,
     step: wp.int32,
-    near_window: wp.int32,
     quiet_steps: wp.int32,
-    held_faces: wp.int32,
-    dt: wp.float64,
     elem_near: wp.array(dtype=wp.int32),
     query_after: wp.array(dtype=wp.int32),
+):
+    """Search state (consider_edge) of an open or woken node n over every exposed edge near it, through the
+    spatial hash; excl: its fan_exclusions mask. Wakes the blocks an open face comes near and sets the node's
+    quiet period (BlockContact doc). With use_cache the points come from the cell grid (the cells wp.HashGrid
+    would visit, in its order, each cell's points in its order) with their exposure in sorted_code; without,
+    from wp.HashGrid itself."""
+    e = n // 3
+    zero = wp.float64(0.0)
+    xn = x[n]
+    vtx = node_vertex[n]
+    # the node's element wedge: unit vectors along its two edges at the node
+    u1 = wp.normalize(x[slot_end(n)] - xn)
+    u2 = wp.normalize(x[slot_prev(n)] - xn)
+    sr = vec6d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero, wp.float64(1.0e300))
+    r2 = search_radius * search_radius
+    if use_cache != 0:
+        xs = cell_coord((xn[0] - search_radius) * cell_inv)
+        xe = cell_end(xs, cell_coord((xn[0] + search_radius) * cell_inv), cell_dim)
+        ys = cell_coord((xn[1] - search_radius) * cell_inv)
+        ye = cell_end(ys, cell_coord((xn[1] + search_radius) * cell_inv), cell_dim)
+        for cy in range(ys, ye + 1):
+            row = cell_wrap(cy, cell_dim) * cell_dim
+            for cx in range(xs, xe + 1):
+                c = row + cell_wrap(cx, cell_dim)
+                for j in range(cell_starts[c], cell_ends[c]):
+                    code = sorted_code[j]
+                    if code > 0:                       # an exposed edge
+                        s = code - 1
+                        pt = sorted_xy[j]
+                        dx = pt[0] - xn[0]
+                        dy = pt[1] - xn[1]
+                        # whole hash cells: keep the points within the search radius
+                        if s // 3 != e and dx * dx + dy * dy <= r2:
+                            sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, node_vertex, fan_index, slot_iface,
+                                           pair_mode, x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
+    else:
+        query = wp.hash_grid_query(grid, wp.vec3d(xn[0], xn[1], zero), search_radius)
+        i = int(0)
+        while wp.hash_grid_query_next(query, i):
+            s = sample_slot[i]
+            p3 = points[i]
+            dx = p3[0] - xn[0]
+            dy = p3[1] - xn[1]
+            # the query returns whole hash cells: keep the points within the search radius
+            if s // 3 != e and dx * dx + dy * dy <= r2:
+                if slot_exposed(s, slot_iface, pair_mode):
+                    sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, node_vertex, fan_index, slot_iface, pair_mode,
+                                   x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
+    query_after[n] = 0
+    if is_open and sr[0] < zero and sr[5] >= wake_dist:
+        query_after[n] = step + quiet_steps
+    return vec5d(sr[0], sr[1], sr[2], sr[3], sr[4])
+
+
+@wp.func
+def contact_force(
+    n: wp.int32,
+    trib: wp.float64,
+    st: vec5d,
+    node_mass: wp.array(dtype=wp.float64),
+    x: wp.array(dtype=wp.vec2d),
+    v: wp.array(dtype=wp.vec2d),
+    kn_area: wp.float64,
+    mu_f: wp.float64,
+    dt: wp.float64,
     contact_slot: wp.array(dtype=wp.int32),
     contact_fs: wp.array(dtype=wp.float64),
     contact_d0: wp.array(dtype=wp.float64),
@@ -377,84 +953,12 @@ def contact_node(
     energy_acc: wp.array(dtype=wp.float64),
     loss_acc: wp.array(dtype=wp.float64),
 ):
-    """Contact search and forces of candidate node n (trib: its tributary length [m]); see the module doc."""
-    e = n // 3
+    """Contact forces of candidate node n (trib: its tributary length [m]) from its search state st
+    (hash_search or held_search) and its contact history; see the module doc."""
     zero = wp.float64(0.0)
     one = wp.float64(1.0)
     half = wp.float64(0.5)
-    sp = slot_prev(n)
     xn = x[n]
-    vtx = node_vertex[n]
-    # the node's element wedge: unit vectors along its two edges at the node
-    u1 = wp.normalize(x[slot_end(n)] - xn)
-    u2 = wp.normalize(x[sp] - xn)
-    st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
-    excl = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
-    is_open = slot_open(n, slot_iface, pair_dropped) or slot_open(sp, slot_iface, pair_dropped)
-    # flags set in this step are not read until the next one: the result does not depend on thread order
-    woken = elem_near[e] >= step - near_window and elem_near[e] < step
-    if is_open or woken:
-        # every exposed edge near the node, through the spatial hash
-        closest = wp.float64(1.0e300)
-        query = wp.hash_grid_query(grid, wp.vec3d(xn[0], xn[1], zero), search_radius)
-        i = int(0)
-        while wp.hash_grid_query_next(query, i):
-            s = sample_slot[i]
-            pt = points[i]
-            dx = pt[0] - xn[0]
-            dy = pt[1] - xn[1]
-            # the query returns whole hash cells: keep the points within the search radius
-            if s // 3 != e and dx * dx + dy * dy <= search_radius * search_radius:
-                if slot_exposed(s, slot_iface, pair_mode):
-                    s_end = slot_end(s)
-                    skip = bool(False)
-                    corner = wp.int32(-1)
-                    if node_vertex[s] == vtx:
-                        skip = in_mask(excl, s, fan_index)
-                        corner = slot_prev(s)
-                    elif node_vertex[s_end] == vtx:
-                        skip = in_mask(excl, s_end, fan_index)
-                        corner = s_end
-                    if not skip:
-                        c = edge_coords(xn, x[s], x[s_end])
-                        st = consider_edge(s, c, corner, xn, u1, u2, x, slot_iface, pair_mode, st, max_depth,
-                                           touch_tol)
-                        closest = wp.min(closest, c[2])
-                        if is_open and c[2] < wake_dist:
-                            elem_near[s // 3] = step          # wake the block this open face comes near
-        query_after[n] = 0
-        if is_open and st[0] < zero and closest >= wake_dist:
-            query_after[n] = step + quiet_steps
-    elif held_faces != 0:
-        # broken faces still held by their springs, not woken: only the other blocks at the node's vertex
-        for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
-            other = vertex_nodes[j]
-            if other // 3 != e:
-                skip_fan = in_mask(excl, other, fan_index)
-                if not skip_fan:
-                    sb = slot_prev(other)                    # the two edges of other's element at the vertex
-                    ex1 = slot_exposed(other, slot_iface, pair_mode)
-                    ex2 = slot_exposed(sb, slot_iface, pair_mode)
-                    # only a node inside the corner (behind both exposed edges) can be a contact: a cheap
-                    # sign test first, the full evaluation for the few that pass
-                    if ex1 or ex2:
-                        xc = x[other]
-                        t1 = x[slot_end(other)] - xc
-                        t2 = xc - x[sb]
-                        r1 = xn - xc
-                        r2 = xn - x[sb]
-                        c1 = t1[1] * r1[0] - t1[0] * r1[1]
-                        c2 = t2[1] * r2[0] - t2[0] * r2[1]
-                        tol2 = touch_tol * touch_tol
-                        inside1 = (not ex1) or c1 <= zero or c1 * c1 <= tol2 * wp.dot(t1, t1)
-                        inside2 = (not ex2) or c2 <= zero or c2 * c2 <= tol2 * wp.dot(t2, t2)
-                        if inside1 and inside2:
-                            if ex1:
-                                st = consider_edge(other, edge_coords(xn, xc, x[slot_end(other)]), sb, xn, u1, u2,
-                                                   x, slot_iface, pair_mode, st, max_depth, touch_tol)
-                            if ex2:
-                                st = consider_edge(sb, edge_coords(xn, x[sb], xc), other, xn, u1, u2, x,
-                                                   slot_iface, pair_mode, st, max_depth, touch_tol)
     best = int(st[0])
     best_g = st[2]
     near_inside = st[4] > zero
@@ -569,11 +1073,21 @@ def contact_node(
     wp.atomic_add(f, ib, -xi * force)
 
 
+
 @wp.kernel
 def eval_block_contact(
+    node_list: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    use_cache: wp.int32,
     grid: wp.uint64,
     points: wp.array(dtype=wp.vec3d),
     sample_slot: wp.array(dtype=wp.int32),
+    cell_inv: wp.float64,
+    cell_dim: wp.int32,
+    cell_starts: wp.array(dtype=wp.int32),
+    cell_ends: wp.array(dtype=wp.int32),
+    sorted_xy: wp.array(dtype=wp.vec2d),
+    sorted_code: wp.array(dtype=wp.int32),
     slot_iface: wp.array(dtype=wp.int32),
     slot_l0: wp.array(dtype=wp.float64),
     node_vertex: wp.array(dtype=wp.int32),
@@ -599,6 +1113,10 @@ def eval_block_contact(
     quiet_steps: wp.int32,
     held_faces: wp.int32,
     dt: wp.float64,
+    node_face: wp.array(dtype=wp.vec2d),
+    fan_excl: wp.array(dtype=wp.int64),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
     elem_near: wp.array(dtype=wp.int32),
     query_after: wp.array(dtype=wp.int32),
     contact_slot: wp.array(dtype=wp.int32),
@@ -610,34 +1128,46 @@ def eval_block_contact(
     energy_acc: wp.array(dtype=wp.float64),
     loss_acc: wp.array(dtype=wp.float64),
 ):
-    n = wp.tid()
-    zero = wp.float64(0.0)
-    half = wp.float64(0.5)
-    # tributary length [m]: half of each exposed edge of the node's own element at the node; 0: not a candidate
-    # (edges only ever become exposed, so such a node never had a contact). The search itself is a function so
-    # that the many nodes that leave here do not pay for its locals.
-    sp = slot_prev(n)
-    trib = zero
-    if slot_exposed(n, slot_iface, pair_mode):
-        trib = trib + half * slot_l0[n]
-    if slot_exposed(sp, slot_iface, pair_mode):
-        trib = trib + half * slot_l0[sp]
-    if trib == zero:
+    """Contact of each listed node (select_contact_nodes). The tests that listed it are made again here, in
+    list order, so that the result is that of one pass over every node in node order (a node's woken flag can
+    turn off in the pass)."""
+    i = wp.tid()
+    if i >= counts[1]:
         return
-    is_open = slot_open(n, slot_iface, pair_dropped) or slot_open(sp, slot_iface, pair_dropped)
-    woken = elem_near[n // 3] >= step - near_window and elem_near[n // 3] < step
+    n = node_list[i]
+    zero = wp.float64(0.0)
+    nf = wp.vec2d()
+    if use_cache != 0:
+        nf = node_face[n]
+    else:
+        nf = node_faces(n, slot_iface, slot_l0, pair_mode, pair_dropped)
+    if nf[0] == zero:
+        return                                    # no exposed edge at the node (listed nodes always have one)
+    is_open = nf[1] != zero
+    woken = node_woken(n // 3, elem_near, step, near_window)
     if not (is_open or woken) and held_faces == 0 and contact_slot[n] < 0:
         return                                    # held broken faces not searched (BlockContact.held_faces)
-    # an open node whose last search found nothing within reach skips the search (BlockContact doc)
     if is_open and not woken and step < query_after[n] and contact_slot[n] < 0:
         return
-    contact_node(
-        n, trib, grid, points, sample_slot, slot_iface, slot_l0, node_vertex, vertex_start, vertex_nodes, fan_index,
-        node_mass,
-        node_pairs, pair_i, pair_j, pair_mode, pair_dropped, x, v, kn_area, mu_f, search_radius, max_depth,
-        touch_tol, wake_dist, step, near_window, quiet_steps, held_faces, dt, elem_near, query_after, contact_slot,
-        contact_fs, contact_d0, contact_p, contact_kc, f, energy_acc, loss_acc,
-    )
+    excl = wp.int64(0)
+    if use_cache != 0:
+        excl = fan_excl[n]
+    else:
+        excl = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
+    st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
+    if is_open or woken:
+        st = hash_search(n, is_open, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim, cell_starts,
+                         cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index, pair_mode, x,
+                         search_radius, max_depth, touch_tol, wake_dist, step, quiet_steps, elem_near, query_after)
+    elif held_faces != 0:
+        # broken faces still held by their springs, not woken: only the other blocks at the node's vertex
+        st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,
+                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count)
+        # nothing found and no contact to end: contact_force would only rewrite the zeros of a node without one
+        if st[0] < zero and contact_slot[n] < 0:
+            return
+    contact_force(n, nf[0], st, node_mass, x, v, kn_area, mu_f, dt, contact_slot, contact_fs, contact_d0,
+                  contact_p, contact_kc, f, energy_acc, loss_acc)
 
 
 class BlockContact:
@@ -663,12 +1193,31 @@ class BlockContact:
         first = np.repeat(np.cumsum(k) - k, k)
         frac = (np.arange(len(slot)) - first + 0.5) / np.repeat(k, k)
         self.sample_slot = wp.array(slot.astype(np.int32), dtype=wp.int32, device=d)
+        self.slot_samples = wp.array(np.stack([np.cumsum(k) - k, k], 1).astype(np.int32), dtype=wp.vec2i, device=d)
         self.sample_frac = wp.array(frac, dtype=wp.float64, device=d)
         self.radius = 0.5 * 1.25 * self.l_ref + self.h_min       # 25 % allowance for edges that stretch
         # about one hash cell per point keeps the bucket occupancy constant as meshes grow
         dim = int(min(4096, max(16, math.sqrt(len(slot)))))
         self.grid = wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64)
         self.points = wp.zeros(len(slot), dtype=wp.vec3d, device=d)
+        # The same hash as a cell grid of our own (with the fan cache): the cells wp.HashGrid would hold, each
+        # cell's points stored together in its order, so that a query reads them in sequence and meets the same
+        # points in the same order (the same results); their exposure is in sorted_code (no loads of the springs).
+        # Built from a stable radix sort by cell, as wp.HashGrid builds its own.
+        self.cell_dim = dim
+        self._key_bits = max(1, int(dim * dim - 1).bit_length())     # cell keys are below 2**_key_bits
+        self.cell_inv = 1.0 / self.radius                         # wp.HashGrid: cell width = query radius
+        ns = len(slot)
+        self._keys = wp.zeros(2 * ns, dtype=wp.int32, device=d)
+        self._values = wp.zeros(2 * ns, dtype=wp.int32, device=d)
+        self.sample_xy = wp.zeros(ns, dtype=wp.vec2d, device=d)
+        self.sample_code = wp.zeros(ns, dtype=wp.int32, device=d)
+        self.sorted_xy = wp.zeros(ns, dtype=wp.vec2d, device=d)
+        self.sorted_code = wp.zeros(ns, dtype=wp.int32, device=d)
+        self.sample_pos = wp.zeros(ns, dtype=wp.int32, device=d)
+        self.cell_starts = wp.zeros(dim * dim, dtype=wp.int32, device=d)
+        self.cell_ends = wp.zeros(dim * dim, dtype=wp.int32, device=d)
+        self._grid_kind = -1                                      # which hash the last rebuild built (use_cache)
         self.slot_iface = wp.array(model.topology.slot_iface.astype(np.int32), dtype=wp.int32, device=d)
         self.slot_l0 = wp.array(lengths.ravel(), dtype=wp.float64, device=d)
         vertex = model.topology.node_vertex
@@ -710,7 +1259,57 @@ class BlockContact:
         # 5.2 without contact)
         # but its blocks can slide up to ~0.3·h into their fan neighbours before their springs drop.
         self.held_faces = True
+        # Fan cache (module doc, "Cost"): each node's fan_exclusions mask and its fan candidates (the nodes of the
+        # other blocks at its vertex that it may meet: not excluded, an exposed edge at the vertex), rebuilt for
+        # the nodes of a vertex only when a spring whose state they depend on changes (mark_pair_changes
+        # compares the spring states with those of the last step). Off, every held node walks its fan every step;
+        # the results are the same (tests/unit/test_contact_cache.py).
+        self.fan_cache = True
+        pn = model.topology.pair_nodes
+        si = model.topology.slot_iface
+        both = np.flatnonzero(si >= 0)                               # the two element edges of each interface
+        iface_slots = both[np.argsort(si[both], kind="stable")].reshape(-1, 2)
+        self.iface_slots = wp.array(iface_slots.astype(np.int32), dtype=wp.vec2i, device=d)
+        self.pair_vertex = wp.array(vertex[pn[:, 0]].astype(np.int32), dtype=wp.int32, device=d)
+        self.seen_mode = wp.full(len(pn), -1, dtype=wp.int32, device=d)
+        self.seen_dropped = wp.full(len(pn), -1, dtype=wp.int32, device=d)
+        self.vertex_stamp = wp.full(int(vertex.max()) + 1, -(1 << 30), dtype=wp.int32, device=d)
+        self.node_face = wp.zeros(n, dtype=wp.vec2d, device=d)       # node_faces: (tributary length, open)
+        self.node_flag = wp.zeros(n, dtype=wp.int32, device=d)       # 0 no exposed edge, 1 held, 2 open
+        self.fan_excl = wp.zeros(n, dtype=wp.int64, device=d)
+        self.fan_cand = wp.zeros((n, int(FAN_CACHE)), dtype=wp.int32, device=d)
+        self.fan_count = wp.full(n, -1, dtype=wp.int32, device=d)     # −1: not cached, walk the fan
+        self.vertex_count = int(vertex.max()) + 1
+        self._dirty_vertices = wp.zeros(self.vertex_count, dtype=wp.int32, device=d)
+        self._cache_fresh = False
+        self._counts = wp.zeros(2, dtype=wp.int32, device=d)          # dirty vertices, listed nodes
+        self._node_list = wp.zeros(n, dtype=wp.int32, device=d)       # the nodes of this step's contact pass
+        self._all_nodes = wp.array(np.arange(n, dtype=np.int32), dtype=wp.int32, device=d)   # without the cache
+        self._counts_all = wp.array([0, n], dtype=wp.int32, device=d)
+        self._cand_list = wp.zeros(n, dtype=wp.int32, device=d)       # list_candidates
+        self._cand_count = wp.zeros(1, dtype=wp.int32, device=d)
+        self._n_cand = 0
         self._step = 0
+        self._launches: dict = {}
+
+    def _launch(self, kernel, dim: int, params: list) -> None:
+        """wp.launch(kernel, dim, inputs=params) through a recorded launch (wp.launch(record_cmd=True)): packing
+        ~45 arguments costs ~50 µs a launch on a CPU, a replay only sets the scalars that changed. Recorded
+        again whenever an array argument is another object (another State)."""
+        arrays = [a for a in params if isinstance(a, wp.array)]
+        rec = self._launches.get(kernel.key)
+        if rec is None or len(rec[1]) != len(arrays) or any(a is not b for a, b in zip(rec[1], arrays)):
+            cmd = wp.launch(kernel, dim=dim, inputs=params, device=self.model.device, record_cmd=True)
+            rec = (cmd, arrays, list(params))
+            self._launches[kernel.key] = rec
+        else:
+            cmd, _, last = rec
+            for i, a in enumerate(params):
+                if not isinstance(a, wp.array) and a != last[i]:
+                    cmd.set_param_at_index(i, a)
+                    last[i] = a
+            cmd.set_dim(dim)
+        rec[0].launch()
 
     def apply(self, state, dt: float) -> None:
         """Add the contact forces of the current configuration to state.f; dt [s] drives the friction."""
@@ -718,24 +1317,76 @@ class BlockContact:
             return
         m = self.model
         radius = self.radius
-        if self._since_build >= self.rebuild_interval:
-            wp.launch(compute_edge_samples, dim=self.points.shape[0],
-                      inputs=[state.x, self.sample_slot, self.sample_frac], outputs=[self.points], device=m.device)
-            self.grid.build(self.points, radius)
+        use_cache = int(bool(self.fan_cache))
+        # (a switch of fan_cache builds the other hash at once: only tests and benchmarks switch)
+        if self._since_build >= self.rebuild_interval or use_cache != self._grid_kind:
+            ns = self.points.shape[0]
+            if use_cache:
+                wp.launch(compute_sample_cells, dim=ns,
+                          inputs=[state.x, self.sample_slot, self.sample_frac, self.slot_iface, state.pair_mode,
+                                  self.cell_inv, self.cell_dim],
+                          outputs=[self.sample_xy, self.sample_code, self._keys, self._values], device=m.device)
+                wp.utils.radix_sort_pairs(self._keys, self._values, ns, end_bit=self._key_bits)
+                self.cell_starts.zero_()
+                self.cell_ends.zero_()
+                wp.launch(gather_sample_cells, dim=ns,
+                          inputs=[self._keys, self._values, ns, self.sample_xy, self.sample_code],
+                          outputs=[self.cell_starts, self.cell_ends, self.sorted_xy, self.sorted_code,
+                                   self.sample_pos], device=m.device)
+            else:
+                wp.launch(compute_edge_samples, dim=ns, inputs=[state.x, self.sample_slot, self.sample_frac],
+                          outputs=[self.points], device=m.device)
+                self.grid.build(self.points, radius)
+            self._grid_kind = use_cache
             self._since_build = 0
         self._since_build += 1
         self._step += 1
-        wp.launch(eval_block_contact, dim=m.node_count,
-                  inputs=[self.grid.id, self.points, self.sample_slot, self.slot_iface, self.slot_l0, self.node_vertex,
-                          self.vertex_start, self.vertex_nodes, self.fan_index, m.node_mass,
-                          m.node_pairs, m.pair_i, m.pair_j, state.pair_mode, state.pair_dropped, state.x, state.v,
-                          wp.float64(self.kn_area), wp.float64(self.mu_f),
-                          wp.float64(radius), wp.float64(0.5 * self.h_min), wp.float64(1e-9 * self.h_min),
-                          wp.float64(self.h_min), wp.int32(self._step), wp.int32(self.near_window),
-                          wp.int32(self.rebuild_interval), wp.int32(self.held_faces), wp.float64(dt)],
-                  outputs=[self.elem_near, self.query_after, self.contact_slot, self.contact_fs, self.contact_d0,
-                           self.contact_p, self.contact_kc, state.f, state.energy_acc, self.loss_acc],
-                  device=m.device)
+        step = self._step
+        cpu = wp.get_device(m.device).is_cpu
+        self._counts.zero_()
+        if use_cache:
+            # caches of the vertices where a spring changed state since the last call (of every vertex at first)
+            refresh_all = int(not self._cache_fresh)
+            if m.spring_count:
+                self._launch(mark_pair_changes, m.spring_count,
+                             [state.pair_mode, state.pair_dropped, self.pair_vertex, step, self.seen_mode,
+                              self.seen_dropped, self.vertex_stamp, self._counts, self._dirty_vertices,
+                              self.iface_slots, self.slot_samples, self.sample_pos, self.sorted_code])
+            # on a CPU the launches run over the listed items only; a GPU thread past a list's end leaves at once
+            dim = int(self._counts.numpy()[0]) if cpu and not refresh_all else self.vertex_count
+            if dim:
+                self._launch(refresh_fan_cache, dim,
+                             [refresh_all, self._counts, self._dirty_vertices, self.node_vertex, self.vertex_start,
+                              self.vertex_nodes, self.fan_index, self.slot_iface, self.slot_l0, m.node_pairs,
+                              m.pair_i, m.pair_j, state.pair_mode, state.pair_dropped, self.node_face, self.node_flag,
+                              self.fan_excl, self.fan_cand, self.fan_count])
+                self._cand_count.zero_()
+                self._launch(list_candidates, m.node_count, [self.node_flag, self._cand_count, self._cand_list])
+                self._n_cand = int(self._cand_count.numpy()[0]) if cpu else m.node_count
+        self._cache_fresh = bool(use_cache)
+        held, window, touch = int(bool(self.held_faces)), int(self.near_window), 1e-9 * self.h_min
+        node_list, counts, dim = self._all_nodes, self._counts_all, m.node_count
+        if use_cache and self._n_cand == 0:
+            return                                    # no node has an exposed edge
+        if use_cache:
+            self._launch(select_contact_nodes, self._n_cand,
+                         [self._cand_list, self._cand_count, state.x, touch, step, window, held, self.elem_near, self.query_after, self.contact_slot,
+                          self.node_flag, self.fan_cand, self.fan_count, self._counts, self._node_list])
+            node_list, counts = self._node_list, self._counts
+            if cpu:
+                dim = int(self._counts.numpy()[1])
+        if dim == 0:
+            return
+        self._launch(eval_block_contact, dim,
+                     [node_list, counts, use_cache, self.grid.id, self.points, self.sample_slot, self.cell_inv,
+                      self.cell_dim, self.cell_starts, self.cell_ends, self.sorted_xy, self.sorted_code,
+                      self.slot_iface, self.slot_l0, self.node_vertex, self.vertex_start, self.vertex_nodes,
+                      self.fan_index, m.node_mass, m.node_pairs, m.pair_i, m.pair_j, state.pair_mode,
+                      state.pair_dropped, state.x, state.v, self.kn_area, self.mu_f, radius, 0.5 * self.h_min, touch,
+                      self.h_min, step, window, int(self.rebuild_interval), held, float(dt), self.node_face,
+                      self.fan_excl, self.fan_cand, self.fan_count, self.elem_near, self.query_after,
+                      self.contact_slot, self.contact_fs, self.contact_d0, self.contact_p, self.contact_kc, state.f,
+                      state.energy_acc, self.loss_acc])
 
     # ------------------------------------------------------------------ diagnostics (host side, not per step)
     def stored_energy(self) -> float:
