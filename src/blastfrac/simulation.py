@@ -18,10 +18,10 @@ import warp as wp
 from . import __version__
 from ._warp import resolve_device
 from .analysis.energy import budget_error, gas_energies, rock_energies
-from .analysis.fracture import FractureDegree
+from .analysis.fracture import FractureDegree, joint_spring_mask
 from .analysis.monitors import MonitorSet
 from .cdem.solver import CDEMSolver
-from .io.paraview import GasSeries, ParaviewSeries, crack_segments
+from .io.paraview import GasSeries, ParaviewSeries, crack_segments, joint_segments
 from .io.tables import CsvHistory, monitor_unit, write_summary
 from .model.builder import ModelBuilder
 from .scenario.load import write_resolved
@@ -145,7 +145,8 @@ class Simulation:
         self.steps = 0
         self.alpha = scenario.simulation.damping
         X = self.model.host["node_X"]
-        self.fracture = FractureDegree(X[self.model.topology.pair_nodes[:, 0]], scenario.zones)
+        self.fracture = FractureDegree(X[self.model.topology.pair_nodes[:, 0]], scenario.zones,
+                                       exclude=joint_spring_mask(self.model))      # D counts blast cracks only
         self.monitors = MonitorSet(scenario.monitors, X, self.model.host["node_mass"])
         self.insitu_report: dict | None = None
         self.initial_stored = 0.0
@@ -788,7 +789,8 @@ class Simulation:
         title = self.scenario.title or "blastfrac"
         figures.fracture_pattern(self.out_dir / "fracture_pattern.png", x, seg, cmode,
                                  title=f"{title}: cracks at t = {self.time * 1e6:.1f} µs",
-                                 show_mesh=self.model.element_count <= 60_000, circles=circles, detached=detached)
+                                 show_mesh=self.model.element_count <= 60_000, circles=circles, detached=detached,
+                                 joints=joint_segments(self.model))
         figures.displacement_map(self.out_dir / "displacement.png", x, x - self.model.host["node_X"],
                                  title=f"{title}: |u| at t = {self.time * 1e6:.1f} µs")
         if self.snapshots:

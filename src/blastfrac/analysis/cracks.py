@@ -38,6 +38,10 @@ from the hole centre.
   crushed zone into one crack.
 * **Radial crack lengths**: the k-th longest crack reaches R_k = max{R : N(R) ≥ k}; its length is
   R_k − r_c (measured from the edge of the crushed zone), for k = 1 … N_rad.
+
+Pre-existing joints (geometry.joints, docs/joints.md) are not blast cracks: their interfaces are never
+*cracked* here, whether open from t = 0 or broken during the run, and they count in no ring of the
+crushed-zone radius (:func:`blast_cracked`).
 """
 
 from __future__ import annotations
@@ -223,6 +227,19 @@ def ring_width(L: np.ndarray, r: np.ndarray, r_b: float) -> float:
     return float(np.median(L[near])) if near.any() else float(np.median(L))
 
 
+def joint_interface_mask(model) -> np.ndarray | None:
+    """The interfaces on pre-existing joints, mask [Q], or None for a model without joints."""
+    jq = model.host.get("iface_joint")
+    return None if jq is None or not np.any(jq >= 0) else jq >= 0
+
+
+def blast_cracked(model, mode: np.ndarray) -> np.ndarray:
+    """Interfaces with a broken spring that are not on a joint, mask [Q]."""
+    cracked = (mode.reshape(-1, 2) > 0).any(axis=1)
+    joint = joint_interface_mask(model)
+    return cracked if joint is None else cracked & ~joint
+
+
 def crushed_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float, w: float) -> float:
     """Crushed-zone radius r_c [m]: outer radius of the rings of width w [m] from the wall, each ≥ half cracked.
 
@@ -250,7 +267,8 @@ def connected_network(model, cracked: np.ndarray, center: np.ndarray, r_b: float
     L = np.linalg.norm(b - a, axis=1)
     r = np.linalg.norm(0.5 * (a + b) - center, axis=1)
     w = ring_width(L, r, r_b)
-    r_c = crushed_zone_radius(r, cracked, r_b, w)
+    joint = joint_interface_mask(model)
+    r_c = crushed_zone_radius(r, cracked, r_b, w) if joint is None else crushed_zone_radius(r[~joint], cracked[~joint], r_b, w)
     ends = interface_vertices(model)
     label = vertex_components(ends, cracked, len(model.mesh.vertices))[ends[:, 0]]
     wall = wall_vertices(model, center, r_b, w)
@@ -279,7 +297,7 @@ def detached_interface_mask(model, mode: np.ndarray, holes) -> np.ndarray:
     ``crack_segments`` (io.paraview) lists the cracked interfaces in index order, so
     ``mask[cracked]`` is the matching per-segment mask.
     """
-    cracked = (mode.reshape(-1, 2) > 0).any(axis=1)
+    cracked = blast_cracked(model, mode)
     attached = np.zeros_like(cracked)
     for c, r_b in holes:
         attached |= connected_network(model, cracked, np.asarray(c, float), float(r_b))["connected"]
@@ -297,8 +315,8 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
     pn = model.topology.pair_nodes
     a, b = X[pn[0::2, 0]], X[pn[1::2, 0]]       # the two ends of each interface (side e1)
     pair_mode = mode.reshape(-1, 2)
-    cracked = (pair_mode > 0).any(axis=1)
-    tensile = (pair_mode == 1).any(axis=1)
+    cracked = blast_cracked(model, mode)
+    tensile = (pair_mode == 1).any(axis=1) & cracked
     net = connected_network(model, cracked, center, r_b)
     w, r_c, connected = net["w"], net["r_c"], net["connected"]
     # crack crossings of circles outside the crushed zone

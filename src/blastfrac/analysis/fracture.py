@@ -4,6 +4,10 @@ A *spring* is one node pair of an interface (its normal and tangential parts bre
 so an interior edge holds two springs. Zone membership is decided by the spring's reference
 position (the two nodes of a pair coincide initially). Per-zone degrees divide by the zone's
 own spring count; the global-denominator variant divides by all springs (METHOD §4).
+
+Pre-existing joints (geometry.joints) are not blast fracture: with ``exclude`` (the joint springs,
+``model.host["pair_joint"] >= 0``, see :func:`joint_spring_mask`) they count in neither the numerator nor the
+denominator of any degree, whether they were open from t = 0 or broke during the run (docs/joints.md).
 """
 
 from __future__ import annotations
@@ -32,16 +36,26 @@ def zone_mask(zone, xy: np.ndarray) -> np.ndarray:
 class FractureDegree:
     """Counts broken springs by mode in the whole model and in each zone."""
 
-    def __init__(self, pair_xy: np.ndarray, zones: list):
-        self.total = len(pair_xy)
+    def __init__(self, pair_xy: np.ndarray, zones: list, exclude: np.ndarray | None = None):
+        """``exclude``: springs counted nowhere (the joints' springs), mask [P]; None: none."""
+        self.keep = None if exclude is None or not np.any(exclude) else ~np.asarray(exclude, bool)
+        self.total = len(pair_xy) if self.keep is None else int(self.keep.sum())
         self.zones = zones
         self.masks = [zone_mask(z, pair_xy) for z in zones]
+        if self.keep is not None:
+            self.masks = [m & self.keep for m in self.masks]
         self.zone_totals = [int(m.sum()) for m in self.masks]
+
+    def _modes(self, mode: np.ndarray):
+        tens = mode == TENSILE
+        shear = mode == SHEAR
+        if self.keep is not None:
+            tens, shear = tens & self.keep, shear & self.keep
+        return tens, shear
 
     def sample(self, mode: np.ndarray) -> dict[str, float]:
         """Fracture degrees from the spring mode array (0 intact, 1 tensile, 2 shear)."""
-        tens = mode == TENSILE
-        shear = mode == SHEAR
+        tens, shear = self._modes(mode)
         n = max(self.total, 1)
         row = {
             "D": (tens.sum() + shear.sum()) / n,
@@ -57,7 +71,14 @@ class FractureDegree:
         return {k: float(v) for k, v in row.items()}
 
     def counts(self, mode: np.ndarray) -> dict[str, int]:
-        return {"total": self.total, "tensile": int(np.sum(mode == TENSILE)), "shear": int(np.sum(mode == SHEAR))}
+        tens, shear = self._modes(mode)
+        return {"total": self.total, "tensile": int(tens.sum()), "shear": int(shear.sum())}
+
+
+def joint_spring_mask(model) -> np.ndarray | None:
+    """The springs on pre-existing joints, mask [P], or None for a model without joints."""
+    pj = model.host.get("pair_joint")
+    return None if pj is None or not np.any(pj >= 0) else pj >= 0
 
 
 def annular_zones(center, r_b: float, r_max: float) -> list[AnnulusZone]:

@@ -46,6 +46,8 @@ def eval_spring_forces(
     tan_phi_r: wp.float64,
     slope_t: wp.float64,
     slope_c: wp.float64,
+    pair_law: wp.array(dtype=wp.vec4d),
+    per_pair_law: wp.int32,
     breakable: wp.int32,
     node_mass: wp.array(dtype=wp.float64),
     zeta: wp.float64,
@@ -59,6 +61,9 @@ def eval_spring_forces(
     With zeta > 0 a dashpot (materials.interface.spring_dashpot) acts beside each spring that carries
     load (intact, or broken and closed); its force is not part of the stored spring force, so it never
     enters the failure criteria, and its work goes to energy_acc[DAMPING_DISSIPATED].
+
+    With per_pair_law = 1 (a model with joints) each spring takes its friction and softening
+    (tanφ, tanφ_r, slope_t, slope_c) from pair_law; otherwise every spring takes the scalars.
     """
     q = wp.tid()
     half = wp.float64(0.5)
@@ -91,11 +96,14 @@ def eval_spring_forces(
         ks = pair_ks[k]
         fn = wp.float64(0.0)
         fs = wp.float64(0.0)
+        law = wp.vec4d(tan_phi, tan_phi_r, slope_t, slope_c)
+        if per_pair_law != 0:
+            law = pair_law[k]
         mode = pair_mode[k]
         if mode == 0:
             st = pair_str[k]
             r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, pair_ac[k],
-                                     tan_phi, tan_phi_r, slope_t, slope_c, breakable)
+                                     law[0], law[1], law[2], law[3], breakable)
             fn = r[0]
             fs = r[1]
             pair_str[k] = wp.vec2d(r[2], r[3])
@@ -120,7 +128,7 @@ def eval_spring_forces(
             elif gap - g0 > pair_l0[k] or wp.abs(wp.dot(rel, tt)) > half * pair_l0[k]:
                 pair_dropped[k] = 1
             else:
-                r2 = spring_update_broken(f0[1], gap, g0, ds, kn, ks, tan_phi_r)
+                r2 = spring_update_broken(f0[1], gap, g0, ds, kn, ks, law[1])
                 fn = r2[0]
                 fs = r2[1]
             pair_work[k] = pair_work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
@@ -143,7 +151,8 @@ def launch_spring_forces(model, state, dt: float, time: float) -> None:
                 state.x, state.v, state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped,
                 state.pair_g0, state.pair_tbreak, state.pair_work, state.pair_efrac,
                 wp.float64(model.tan_phi), wp.float64(model.tan_phi_r), wp.float64(model.slope_t),
-                wp.float64(model.slope_c), wp.int32(model.breakable), model.node_mass,
+                wp.float64(model.slope_c), model.pair_law, wp.int32(model.per_pair_law),
+                wp.int32(model.breakable), model.node_mass,
                 wp.float64(model.spring_damping), wp.float64(dt), wp.float64(time)],
         outputs=[state.pair_force, state.energy_acc],
         device=model.device,

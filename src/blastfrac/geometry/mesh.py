@@ -23,12 +23,16 @@ class TriMesh:
     triangles: vertex indices, counter-clockwise, shape [E, 3]
     boundary_edges: vertex index pairs of boundary segments, shape [B, 2]
     boundary_tags: side name of each boundary edge ('left', 'outer', 'hole0', ...), length B
+    joint_edges: vertex index pairs of the interior edges that lie on a joint (geometry.joints), shape [J, 2]
+    joint_sets: the joint set (index into geometry.joints) of each joint edge, shape [J]
     """
 
     vertices: np.ndarray
     triangles: np.ndarray
     boundary_edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     boundary_tags: list[str] = field(default_factory=list)
+    joint_edges: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    joint_sets: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices[:, :2], dtype=np.float64)
@@ -40,6 +44,10 @@ class TriMesh:
         tri[flip] = tri[flip][:, [0, 2, 1]]
         self.triangles = tri
         self.boundary_edges = np.asarray(self.boundary_edges, dtype=np.int64).reshape(-1, 2)
+        self.joint_edges = np.asarray(self.joint_edges, dtype=np.int64).reshape(-1, 2)
+        self.joint_sets = np.asarray(self.joint_sets, dtype=np.int64).reshape(-1)
+        if len(self.joint_sets) != len(self.joint_edges):
+            raise ValueError("joint_sets must give one set per joint edge")
 
     @property
     def element_count(self) -> int:
@@ -85,21 +93,61 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
     h = geom.mesh_size
     h_near = geom.mesh_size_near or h
     side_curves: dict[str, list[int]] = {}
+    net = None
+    if geom.joints:
+        from .joints import joint_network
+
+        net = joint_network(geom, seed)
+    # joint points on the outer boundary (the boundary curves are split there) and their gmsh tags
+    on_boundary = net.points[net.boundary_points] if net is not None else np.zeros((0, 2))
+    size_at = _joint_point_sizes(geom, net) if net is not None else np.zeros(0)
+    joint_tag: dict[int, int] = {}
 
     def polyline(points: list[tuple[float, float]], names: list[str]) -> int:
         tags = [g.addPoint(x, y, 0.0, h) for x, y in points]
+        for k in (net.boundary_points if net is not None else ()):
+            # a joint that ends at a corner of the domain shares the corner's point
+            dv = np.linalg.norm(np.asarray(points, float) - net.points[k], axis=1)
+            if dv.min() <= 1e-8 * max(float(np.ptp(np.asarray(points, float), axis=0).max()), 1e-300):
+                joint_tag[int(k)] = tags[int(np.argmin(dv))]
         lines = []
         for i, name in enumerate(names):
-            ln = g.addLine(tags[i], tags[(i + 1) % len(tags)])
-            side_curves.setdefault(name, []).append(ln)
-            lines.append(ln)
+            a, b = np.asarray(points[i], float), np.asarray(points[(i + 1) % len(points)], float)
+            chain = [tags[i]]
+            for k, t in _points_on_side(a, b, net, on_boundary):
+                x, y = a + t * (b - a)
+                joint_tag[k] = g.addPoint(x, y, 0.0, min(h, size_at[k]))
+                chain.append(joint_tag[k])
+            chain.append(tags[(i + 1) % len(tags)])
+            for p0, p1 in zip(chain[:-1], chain[1:]):
+                ln = g.addLine(p0, p1)
+                side_curves.setdefault(name, []).append(ln)
+                lines.append(ln)
         return g.addCurveLoop(lines)
 
-    def circle(center: tuple[float, float], r: float, name: str, size: float, reverse: bool) -> int:
+    def circle(center: tuple[float, float], r: float, name: str, size: float, reverse: bool,
+               joint_points: bool = False) -> int:
         c = g.addPoint(center[0], center[1], 0.0, size)
-        pts = [g.addPoint(center[0] + r * math.cos(a), center[1] + r * math.sin(a), 0.0, size)
-               for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
-        arcs = [g.addCircleArc(pts[i], c, pts[(i + 1) % 4]) for i in range(4)]
+        angles = [(a, -1) for a in (0.0, 0.5 * math.pi, math.pi, 1.5 * math.pi)]
+        if joint_points and net is not None and len(net.boundary_points):
+            for k in net.boundary_points:
+                d = net.points[k] - np.asarray(center, float)
+                a = math.atan2(d[1], d[0]) % (2 * math.pi)
+                # a joint end at one of the four default points replaces it
+                angles = [(b, kb) for b, kb in angles
+                          if not (kb < 0 and min(abs(a - b), 2 * math.pi - abs(a - b)) <= 1e-8)]
+                angles.append((a, int(k)))
+            angles.sort()
+        pts = []
+        for a, k in angles:
+            if k < 0:
+                pts.append(g.addPoint(center[0] + r * math.cos(a), center[1] + r * math.sin(a), 0.0, size))
+            else:
+                x, y = net.points[k]
+                joint_tag[k] = g.addPoint(x, y, 0.0, min(size, size_at[k]))
+                pts.append(joint_tag[k])
+        n = len(pts)
+        arcs = [g.addCircleArc(pts[i], c, pts[(i + 1) % n]) for i in range(n)]
         side_curves.setdefault(name, []).extend(arcs)
         loop = [-a for a in reversed(arcs)] if reverse else arcs
         return g.addCurveLoop(loop)
@@ -110,7 +158,7 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
         outer = polyline([(cx - w2, cy - h2), (cx + w2, cy - h2), (cx + w2, cy + h2), (cx - w2, cy + h2)],
                          ["bottom", "right", "top", "left"])
     elif isinstance(d, DiscDomain):
-        outer = circle(d.center, d.radius, "outer", h, reverse=False)
+        outer = circle(d.center, d.radius, "outer", h, reverse=False, joint_points=True)
     elif isinstance(d, PolygonDomain):
         outer = polyline(list(d.vertices), [f"side{i}" for i in range(len(d.vertices))])
     else:  # pragma: no cover - the schema admits no other type
@@ -118,9 +166,20 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
 
     holes = [circle(b.center, b.radius, f"hole{i}", b.mesh_size or h_near, reverse=True)
              for i, b in enumerate(geom.boreholes)]
-    g.addPlaneSurface([outer, *holes])
+    joint_lines: list[tuple[int, int]] = []             # (gmsh curve tag, joint set)
+    if net is not None:
+        for k in range(len(net.points)):
+            if k not in joint_tag:
+                x, y = net.points[k]
+                joint_tag[k] = g.addPoint(x, y, 0.0, min(h, size_at[k]))
+        for (a, b), js in zip(net.edges, net.edge_set):
+            joint_lines.append((g.addLine(joint_tag[int(a)], joint_tag[int(b)]), int(js)))
+    surf = g.addPlaneSurface([outer, *holes])
     g.synchronize()
+    if joint_lines:
+        gmsh.model.mesh.embed(1, [c for c, _ in joint_lines], 2, surf)
 
+    fields = []
     if geom.boreholes and h_near < h:
         hole_curves = [c for i in range(len(geom.boreholes)) for c in side_curves[f"hole{i}"]]
         dist = gmsh.model.mesh.field.add("Distance")
@@ -133,7 +192,29 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
         gmsh.model.mesh.field.setNumber(thr, "SizeMax", h)
         gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
         gmsh.model.mesh.field.setNumber(thr, "DistMax", geom.refinement_distance or 10.0 * rmax)
-        gmsh.model.mesh.field.setAsBackgroundMesh(thr)
+        fields.append(thr)
+    for hj in sorted({geom.joint_mesh_size(i) for i in range(len(geom.joints))}):
+        # joints meshed finer than the rock: size hj on the joint, growing to h over JOINT_GRADING·h
+        curves = [c for c, js in joint_lines if geom.joint_mesh_size(js) == hj]
+        if hj >= h or not curves:
+            continue
+        dist = gmsh.model.mesh.field.add("Distance")
+        gmsh.model.mesh.field.setNumbers(dist, "CurvesList", curves)
+        gmsh.model.mesh.field.setNumber(dist, "Sampling", 200)
+        thr = gmsh.model.mesh.field.add("Threshold")
+        gmsh.model.mesh.field.setNumber(thr, "InField", dist)
+        gmsh.model.mesh.field.setNumber(thr, "SizeMin", hj)
+        gmsh.model.mesh.field.setNumber(thr, "SizeMax", h)
+        gmsh.model.mesh.field.setNumber(thr, "DistMin", 0.0)
+        gmsh.model.mesh.field.setNumber(thr, "DistMax", JOINT_GRADING * h)
+        fields.append(thr)
+    if fields:
+        if len(fields) == 1:
+            gmsh.model.mesh.field.setAsBackgroundMesh(fields[0])
+        else:
+            fmin = gmsh.model.mesh.field.add("Min")
+            gmsh.model.mesh.field.setNumbers(fmin, "FieldsList", fields)
+            gmsh.model.mesh.field.setAsBackgroundMesh(fmin)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
@@ -157,7 +238,44 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
                     e = tag_to_row[en.astype(np.int64)].reshape(-1, 2)
                     bedges.append(e)
                     btags.extend([name] * len(e))
-    return _compact(xy, tri, np.concatenate(bedges) if bedges else np.zeros((0, 2), np.int64), btags)
+    jedges, jsets = [], []
+    for c, js in joint_lines:
+        types, _, enodes = gmsh.model.mesh.getElements(1, c)
+        for t, en in zip(types, enodes):
+            if t == 1:
+                e = tag_to_row[en.astype(np.int64)].reshape(-1, 2)
+                jedges.append(e)
+                jsets.append(np.full(len(e), js, np.int64))
+    joints = (np.concatenate(jedges), np.concatenate(jsets)) if jedges else None
+    return _compact(xy, tri, np.concatenate(bedges) if bedges else np.zeros((0, 2), np.int64), btags, joints)
+
+
+#: a joint meshed finer than geometry.mesh_size grades to mesh_size over this many mesh_size from the joint
+JOINT_GRADING = 4.0
+
+
+def _joint_point_sizes(geom: GeometryConfig, net) -> np.ndarray:
+    """Element size at each network point [m]: the smallest joint mesh size of the edges that meet there."""
+    size = np.full(len(net.points), geom.mesh_size)
+    for (a, b), js in zip(net.edges, net.edge_set):
+        hj = geom.joint_mesh_size(int(js))
+        size[a] = min(size[a], hj)
+        size[b] = min(size[b], hj)
+    return size
+
+
+def _points_on_side(a: np.ndarray, b: np.ndarray, net, on_boundary: np.ndarray) -> list[tuple[int, float]]:
+    """(network point index, parameter along a→b) of the joint points strictly inside the side a→b, in order."""
+    if net is None or not len(on_boundary):
+        return []
+    d = b - a
+    L = float(np.linalg.norm(d))
+    tol = 1e-8 * L
+    t = (on_boundary - a) @ d / (L * L)
+    off = np.abs((on_boundary[:, 0] - a[0]) * d[1] - (on_boundary[:, 1] - a[1]) * d[0]) / L
+    sel = np.flatnonzero((off <= tol) & (t * L > tol) & ((1 - t) * L > tol))
+    sel = sel[np.argsort(t[sel])]
+    return [(int(net.boundary_points[k]), float(t[k])) for k in sel]
 
 
 def morton_order(points: np.ndarray, bits: int = 16) -> np.ndarray:
@@ -171,12 +289,15 @@ def morton_order(points: np.ndarray, bits: int = 16) -> np.ndarray:
     return np.argsort(code, kind="stable")
 
 
-def _compact(xy: np.ndarray, tri: np.ndarray, bedges: np.ndarray, btags: list[str]) -> TriMesh:
+def _compact(xy: np.ndarray, tri: np.ndarray, bedges: np.ndarray, btags: list[str], joints=None) -> TriMesh:
     tri = tri[morton_order(xy[tri].mean(axis=1))]     # neighbouring blocks close in memory
     used = np.zeros(len(xy), bool)
     used[tri.ravel()] = True
     new = np.cumsum(used) - 1
-    return TriMesh(xy[used], new[tri], new[bedges] if len(bedges) else bedges, btags)
+    kw = {}
+    if joints is not None:
+        kw = {"joint_edges": new[joints[0]], "joint_sets": joints[1]}
+    return TriMesh(xy[used], new[tri], new[bedges] if len(bedges) else bedges, btags, **kw)
 
 
 def read_msh(path: str) -> TriMesh:

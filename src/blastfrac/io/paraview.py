@@ -10,6 +10,8 @@ the blocks with ``crack_mode == 0``). The stress is the full 3×3 plane-strain t
 positive, with σ_zz = ν(σ_xx + σ_yy), ν = λ/(2(λ + μ)) the Poisson ratio of the blocks (ε_zz = 0).
 Point field ``ppv``: the peak particle velocity of each node so far [m/s]. With gas in cracks, the crack lines also carry ``crack_gas_pressure`` [Pa] and ``crack_opening`` [m] (0 on the
 triangles and on cracks with one spring broken). Every file is written atomically (io/atomic.py): a killed run leaves whole frames only.
+In a model with pre-existing joints (geometry.joints) the cells also carry ``joint``: on a crack line on a joint
+the joint set's index + 1 (an open joint is a crack line from the first frame), 0 on blast cracks and triangles.
 """
 
 from __future__ import annotations
@@ -52,6 +54,27 @@ def crack_segments(model, mode: np.ndarray, tbreak: np.ndarray) -> tuple[np.ndar
     return seg, crack_mode
 
 
+def joint_segments(model) -> np.ndarray:
+    """Every interface on a pre-existing joint, broken or not, as node index pairs on the e1 side (the same
+    convention as :func:`crack_segments`), shape [J, 2]; empty without joints."""
+    jq = model.host.get("iface_joint")
+    if jq is None:
+        return np.zeros((0, 2), np.int64)
+    q = np.flatnonzero(jq >= 0)
+    pn = model.topology.pair_nodes
+    return np.stack([pn[2 * q, 0], pn[2 * q + 1, 0]], 1)
+
+
+def crack_joint_field(model, mode: np.ndarray) -> np.ndarray | None:
+    """The ``joint`` value of each crack line of :func:`crack_segments` (set index + 1, 0 off joints), or None
+    for a model without joints."""
+    jq = model.host.get("iface_joint")
+    if jq is None or not np.any(jq >= 0):
+        return None
+    broken = np.flatnonzero((mode.reshape(-1, 2) > 0).any(axis=1))
+    return (jq[broken] + 1).astype(np.int32)
+
+
 class ParaviewSeries:
     def __init__(self, directory: Path, name: str = "rock"):
         self.dir = Path(directory)
@@ -72,6 +95,9 @@ class ParaviewSeries:
         n_e, n_c = len(tri), len(seg)
         stress = stress_tensor(sig, block_poisson_ratio(model))
         cell_data = {"stress": [stress], "crack_mode": [np.zeros(n_e, np.int32)]}
+        joint = crack_joint_field(model, state.pair_mode.numpy())
+        if joint is not None:
+            cell_data["joint"] = [np.zeros(n_e, np.int32)]
         if crack_gas is not None:
             cell_data["crack_gas_pressure"] = [np.zeros(n_e)]
             cell_data["crack_opening"] = [np.zeros(n_e)]
@@ -79,6 +105,8 @@ class ParaviewSeries:
             cells.append(("line", seg))
             cell_data["stress"].append(np.zeros((n_c, 9)))
             cell_data["crack_mode"].append(cmode.astype(np.int32))
+            if joint is not None:
+                cell_data["joint"].append(joint)
             if crack_gas is not None:
                 broken = np.flatnonzero((state.pair_mode.numpy().reshape(-1, 2) > 0).any(axis=1))
                 cell_data["crack_gas_pressure"].append(crack_gas.gas.pres.numpy()[broken])

@@ -87,8 +87,6 @@ class ModelBuilder:
             t_q = t_q * self.factors["tensile_strength"]
         if "cohesion" in self.factors:
             c_q = c_q * self.factors["cohesion"]
-        h["pair_t0"] = np.repeat(t_q, 2)
-        h["pair_c0"] = np.repeat(c_q, 2)
         # one softening rate per model (the spring kernels take a scalar): the homogeneous rule at the
         # softest nominal spring, with the area-weighted rms strength of a scattered field. Interface q then
         # dissipates G_f·(T_q/T_rms)², area-weighted mean G_f (docs/heterogeneity.md "Fracture energy")
@@ -96,6 +94,16 @@ class ModelBuilder:
         c_ref = rms(c_q, L) if "cohesion" in self.factors and len(L) else rock.cohesion
         self.slope_t = softening_slope(t_ref, rock.tensile_fracture_energy, kn_min_nominal)
         self.slope_c = softening_slope(c_ref, rock.shear_fracture_energy, ks_min_nominal)
+        # pre-existing joints (geometry.joints, docs/joints.md): their interfaces take the joint's strengths,
+        # friction and (optional) stiffness. The rock's compliance compensation, softening rates and nominal
+        # stiffness above are those of the rock (a joint's own compliance is physical, not compensated).
+        jq = self.topology.iface_joint
+        h["iface_joint"] = jq
+        h["pair_joint"] = np.repeat(jq, 2)
+        if np.any(jq >= 0):
+            self._joint_properties(h, jq, kn_a, ks_a, ac, t_q, c_q)
+        h["pair_t0"] = np.repeat(t_q, 2)
+        h["pair_c0"] = np.repeat(c_q, 2)
         # the unit normal of each interface, e1 → e2, for the stable-step row sums
         t = (X[nb] - X[na]) / L[:, None]
         h["iface_normal"] = np.stack([t[:, 1], -t[:, 0]], 1)
@@ -103,6 +111,36 @@ class ModelBuilder:
         self._boundary_data(h, X)
         self.host = h
         self.stable_dt = self._gershgorin_dt(h, X)
+
+    def _joint_properties(self, h: dict, jq: np.ndarray, kn_a, ks_a, ac, t_q, c_q) -> None:
+        """Give the joint interfaces their set's properties (in place on t_q, c_q and the stiffness arrays)."""
+        rock = self.scenario.rock
+        law = np.empty((len(jq), 4))
+        law[:] = (math.tan(math.radians(rock.friction_angle)), math.tan(math.radians(rock.residual_friction)),
+                  self.slope_t, self.slope_c)
+        mode0 = np.zeros(len(jq), np.int32)
+        for s, js in enumerate(self.scenario.geometry.joints):
+            m = jq == s
+            if not m.any():
+                continue
+            if js.kn is not None:
+                kn_a[m] = js.kn
+            if js.ks is not None:
+                ks_a[m] = js.ks
+            t_q[m] = js.tensile_strength
+            c_q[m] = js.cohesion
+            # joints are brittle: at failure they drop to their residual friction (no softening)
+            law[m] = (math.tan(math.radians(js.friction_angle)), math.tan(math.radians(js.residual_friction)), 0.0, 0.0)
+            if js.open:
+                mode0[m] = 1                                    # broken in tension from t = 0
+                t_q[m] = 0.0
+                c_q[m] = 0.0
+        h["pair_kn_area"] = np.repeat(kn_a, 2)
+        h["pair_kn"] = np.repeat(kn_a * ac, 2)
+        h["pair_ks"] = np.repeat(ks_a * ac, 2)
+        h["pair_law"] = np.repeat(law, 2, axis=0)
+        if mode0.any():
+            h["pair_mode0"] = np.repeat(mode0, 2)
 
     def _boundary_data(self, h: dict, X: np.ndarray) -> None:
         sc, topo = self.scenario, self.topology
@@ -218,6 +256,9 @@ class ModelBuilder:
             pair_l0=arr(h["pair_l0"], wp.float64),
             pair_t0=arr(h["pair_t0"], wp.float64),
             pair_c0=arr(h["pair_c0"], wp.float64),
+            # per-spring (tanφ, tanφ_r, softening slopes) only with joints; the scalars above otherwise
+            pair_law=arr(h["pair_law"] if "pair_law" in h else np.zeros((1, 4)), wp.vec4d),
+            per_pair_law=1 if "pair_law" in h else 0,
             ledge_n0=arr(h["ledge_n0"].astype(np.int32), wp.int32),
             ledge_n1=arr(h["ledge_n1"].astype(np.int32), wp.int32),
             ledge_pulse=arr(h["ledge_pulse"].astype(np.int32), wp.int32),

@@ -31,6 +31,9 @@ class Model:
     pair_ac: tributary area Ac (edge length/2, unit thickness) [m], [P]
     pair_l0: length of the edge the spring belongs to [m], [P]
     pair_t0, pair_c0: initial tensile strength and cohesion [Pa], [P]
+    pair_law: per-spring (tanφ, tanφ_r, slope_t, slope_c), [P] vec4d, read only when per_pair_law = 1 (a model
+        with joints, geometry.joints); otherwise a 1-element placeholder and the scalars tan_phi.. slope_c apply
+    host["pair_joint"]: joint set of each spring (−1 rock), [P]; host["pair_mode0"]: initial pair_mode (open joints)
     spring_damping: dashpot ratio ζ beside every loaded spring [-] (materials.interface.spring_dashpot)
     q_quad, q_lin: coefficients of the blocks' artificial bulk viscosity [-] (materials/artificial_viscosity.py)
     ledge_n0, ledge_n1: nodes of loaded boundary edges (n0→n1 runs counter-clockwise around the element), [L]
@@ -76,6 +79,8 @@ class Model:
     host: dict = field(default_factory=dict)
     mass_theta: float = 0.0   # consistent-mass fraction θ of the block mass matrices (cdem/kernels_integrate.py)
     elastic: object = None    # model.compliance.ElasticReport: input, block and assembly moduli
+    pair_law: wp.array = None  # per-spring friction and softening (joints); see the class docstring
+    per_pair_law: int = 0
 
     @property
     def c_p(self) -> float:
@@ -124,6 +129,11 @@ class Model:
             pulse_values=wp.zeros(max(1, len(self.pulses)), dtype=wp.float64, device=d),
             energy_acc=wp.zeros(4, dtype=wp.float64, device=d),
         )
+        mode0 = self.host.get("pair_mode0")
+        if mode0 is not None:
+            # open joints: broken in tension from t = 0 (their faces interact by contact only)
+            st.pair_mode.assign(mode0.astype(np.int32))
+            st.pair_tbreak.assign(np.where(mode0 > 0, 0.0, -1.0))
         return st
 
 

@@ -31,6 +31,7 @@ class Topology:
     slot_iface: interface of each element edge slot, -1 for a boundary edge, shape [3E]
     boundary_slots: element edge slots on the mesh boundary, shape [B]
     boundary_slot_tags: side name of each boundary slot, length B
+    iface_joint: joint set (index into geometry.joints) of each interface, −1 for rock, shape [Q]
     """
 
     node_vertex: np.ndarray
@@ -42,6 +43,11 @@ class Topology:
     slot_iface: np.ndarray
     boundary_slots: np.ndarray
     boundary_slot_tags: list[str]
+    iface_joint: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.iface_joint is None:
+            self.iface_joint = np.full(len(self.iface_elems), -1, np.int64)
 
 
 def build_topology(mesh: TriMesh) -> Topology:
@@ -85,6 +91,7 @@ def build_topology(mesh: TriMesh) -> Topology:
     slot_iface[s2] = np.arange(n_if)
     boundary_slots = np.flatnonzero(slot_iface < 0)
     tags = _tag_boundary_slots(mesh, a[boundary_slots], b[boundary_slots])
+    iface_joint = _joint_interfaces(mesh, key[s1], nv)
     return Topology(
         node_vertex=a.copy(),
         iface_elems=np.stack([e1, e2], 1),
@@ -95,7 +102,25 @@ def build_topology(mesh: TriMesh) -> Topology:
         slot_iface=slot_iface,
         boundary_slots=boundary_slots,
         boundary_slot_tags=tags,
+        iface_joint=iface_joint,
     )
+
+
+def _joint_interfaces(mesh: TriMesh, iface_key: np.ndarray, nv: int) -> np.ndarray:
+    """Joint set of each interface (−1: rock), from the mesh's joint edges; every joint edge must be interior."""
+    out = np.full(len(iface_key), -1, np.int64)
+    je = mesh.joint_edges
+    if not len(je):
+        return out
+    jkey = np.minimum(je[:, 0], je[:, 1]) * nv + np.maximum(je[:, 0], je[:, 1])
+    order = np.argsort(iface_key)
+    pos = np.searchsorted(iface_key[order], jkey)
+    pos = np.minimum(pos, len(order) - 1)
+    found = iface_key[order][pos] == jkey if len(order) else np.zeros(len(jkey), bool)
+    if not np.all(found):
+        raise ValueError(f"{int((~found).sum())} joint edges are not interior edges of the mesh (a joint on the boundary?)")
+    out[order[pos]] = mesh.joint_sets
+    return out
 
 
 def _fill_node_pairs(pair_nodes, node_pairs, node_pair_sign) -> None:

@@ -26,13 +26,17 @@ SHEAR_DETACHED_COLOR = "#a9c8e6"
 
 
 def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarray, title: str = "",
-                     show_mesh: bool = True, circles=(), detached: np.ndarray | None = None) -> None:
-    """Deformed mesh (light) with tensile (red) and shear (blue) cracks; detached cracks in lighter shades.
+                     show_mesh: bool = True, circles=(), detached: np.ndarray | None = None,
+                     joints: np.ndarray | None = None) -> None:
+    """Deformed mesh (light) with tensile (red) and shear (blue) cracks; detached cracks in lighter shades;
+    pre-existing joints grey and dashed.
 
     ``seg`` [K, 2], ``mode`` [K]: the cracked interfaces and their mode (io.paraview.crack_segments); the
     legend counts cracked interfaces (summary.json → broken_springs counts springs, up to two per interface).
     ``detached`` [K] (optional): the segments in crack sets connected to no borehole
     (analysis.cracks.detached_interface_mask, indexed by the cracked interfaces).
+    ``joints`` [J, 2] (optional): every joint interface (io.paraview.joint_segments), drawn grey and dashed, dark
+    where open or broken; cracked segments on a joint are drawn as joints, not as cracks.
     """
     plt = _plt()
     from matplotlib.collections import LineCollection
@@ -42,6 +46,19 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     if show_mesh:
         edges = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
         ax.add_collection(LineCollection(x[edges], colors="0.82", linewidths=0.2))
+    if joints is not None and len(joints):
+        joints = np.asarray(joints, np.int64).reshape(-1, 2)
+        nmax = int(max(joints.max(), seg.max() if len(seg) else 0)) + 1
+        on_joint = np.isin(seg[:, 0] * nmax + seg[:, 1], joints[:, 0] * nmax + joints[:, 1]) if len(seg) else \
+            np.zeros(0, bool)
+        opened = np.isin(joints[:, 0] * nmax + joints[:, 1], seg[on_joint, 0] * nmax + seg[on_joint, 1])
+        for sel, color, label in ((~opened, "0.55", "joint, intact"), (opened, "0.25", "joint, open or broken")):
+            if sel.any():
+                ax.add_collection(LineCollection(x[joints[sel]], colors=color, linewidths=0.8, linestyles="--",
+                                                 label=f"{label} ({int(sel.sum())})", zorder=1.5))
+        seg, mode = seg[~on_joint], mode[~on_joint]
+        if detached is not None:
+            detached = np.asarray(detached, bool)[~on_joint]
     det = np.zeros(len(seg), bool) if detached is None else np.asarray(detached, bool)
     styles = ((1, False, TENSILE_COLOR, "tensile"), (2, False, SHEAR_COLOR, "shear"),
               (1, True, TENSILE_DETACHED_COLOR, "tensile, detached"),
@@ -59,7 +76,7 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_title(title or "Fracture pattern", fontsize=9, wrap=True)
-    if len(seg):
+    if len(seg) or (joints is not None and len(joints)):
         head = "cracked interfaces" + ("" if detached is None else " (detached: not joined to a hole)")
         ax.legend(loc="upper right", fontsize=8, title=head, title_fontsize=8)
     fig.tight_layout()

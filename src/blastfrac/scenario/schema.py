@@ -51,7 +51,6 @@ class SimulationConfig(_Strict):
     )
 
 
-
 # --------------------------------------------------------------------------- output
 class OutputConfig(_Strict):
     """Where and how often results are written."""
@@ -365,6 +364,129 @@ class Borehole(_Strict):
     mesh_size: float | None = Field(None, gt=0, description="Element size on this wall [m]; default geometry.mesh_size_near.")
 
 
+TraceDistribution = Literal["fixed", "uniform", "exponential", "lognormal", "power_law"]
+
+
+class TraceLengthConfig(_Strict):
+    """Distribution of the trace lengths of a generated joint set (geometry/joints.py, docs/joints.md)."""
+
+    distribution: TraceDistribution = Field(
+        "fixed", description="'fixed' (every trace `mean` long), 'uniform' on [min, max], 'exponential' of mean `mean`, "
+        "'lognormal' of mean `mean` and standard deviation `std`, 'power_law' p(l) ∝ l^−exponent on [min, max].",
+    )
+    mean: float | None = Field(None, gt=0, description="Mean trace length [m] ('fixed', 'exponential', 'lognormal').")
+    std: float | None = Field(None, gt=0, description="Standard deviation of the trace length [m] ('lognormal').")
+    min: float | None = Field(None, gt=0, description="Shortest trace [m]: the lower bound of 'uniform' and 'power_law'; "
+                              "a truncation (redraw below it) for 'exponential' and 'lognormal'.")
+    max: float | None = Field(None, gt=0, description="Longest trace [m]: the upper bound of 'uniform' and 'power_law'; "
+                              "a truncation (redraw above it) for 'exponential' and 'lognormal'.")
+    exponent: float | None = Field(None, gt=1, description="Exponent a of 'power_law' p(l) ∝ l^−a [-], > 1.")
+
+    @model_validator(mode="after")
+    def _parameters(self) -> "TraceLengthConfig":
+        d = self.distribution
+        need = {"fixed": ("mean",), "uniform": ("min", "max"), "exponential": ("mean",),
+                "lognormal": ("mean", "std"), "power_law": ("min", "max", "exponent")}[d]
+        allowed = set(need) | ({"min", "max"} if d in ("exponential", "lognormal") else set())
+        for k in ("mean", "std", "min", "max", "exponent"):
+            v = getattr(self, k)
+            if k in need and v is None:
+                raise ValueError(f"{k}: distribution '{d}' needs {', '.join(need)}")
+            if k not in allowed and v is not None:
+                raise ValueError(f"{k}: not a parameter of distribution '{d}' (it takes {', '.join(sorted(allowed))})")
+        if self.min is not None and self.max is not None and self.max <= self.min:
+            raise ValueError(f"max: must exceed min ({self.max} <= {self.min} m)")
+        if self.mean is not None and d in ("exponential", "lognormal"):
+            if (self.min is not None and self.mean <= self.min) or (self.max is not None and self.mean >= self.max):
+                raise ValueError(f"mean: {self.mean} m must lie between min and max")
+        return self
+
+
+class JointNetworkConfig(_Strict):
+    """A seeded discrete fracture network of one joint set: traces of random position, orientation and length
+    inside a region (geometry/joints.py, docs/joints.md)."""
+
+    angle: float = Field(ge=-180, le=180, description="Mean trace orientation [deg], counter-clockwise from +x, "
+                         "in [−180, 180] (a trace at θ is the same as at θ ± 180).")
+    angle_spread: float = Field(0.0, ge=0, le=90, description="Standard deviation of the trace orientation about "
+                                "`angle` [deg] (normal distribution), in [0, 90]; 0: all traces parallel.")
+    spacing: float | None = Field(None, gt=0, description="Mean set spacing s [m], measured along the set's normal: "
+                                  "trace length per unit area P21 = 1/s. Without `length` the traces are persistent "
+                                  "(they cross the whole region) at exactly this spacing. Give spacing or density.")
+    density: float | None = Field(None, gt=0, description="Traces per unit area P20 [1/m²] (their centres lie in "
+                                  "the region); needs `length`. Give spacing or density.")
+    length: TraceLengthConfig | None = Field(None, description="`[geometry.joints.dfn.length]`: trace-length "
+                                             "distribution; none: persistent traces across the region.")
+    region: Domain | None = Field(None, description="Rectangle, disc or polygon (as `geometry.domain`) in which "
+                                    "the trace centres lie and to which the traces are clipped; default the "
+                                    "domain's bounding box (traces are always clipped to the domain).")
+    seed: int | None = Field(None, ge=0, le=2**31 - 1, description="Seed of this set's network [-]; default "
+                             "simulation.seed. Two sets of one scenario draw from independent streams.")
+    min_gap: float | None = Field(None, gt=0, description="Closest approach [m] allowed between two traces that do not "
+                                  "meet, between a trace's end and the domain boundary or another trace (the end is "
+                                  "then extended to meet it), and the shortest piece kept beyond a crossing; "
+                                  "default the set's mesh size. Features below it would need smaller elements.")
+    min_angle: float = Field(20.0, ge=0, lt=90, description="Smallest crossing angle with another trace [deg]; "
+                             "a trace that would cross at less is redrawn (thin slivers of rock mesh badly).")
+
+    @model_validator(mode="after")
+    def _intensity(self) -> "JointNetworkConfig":
+        if (self.spacing is None) == (self.density is None):
+            raise ValueError("spacing: give exactly one of spacing [m] and density [1/m²]")
+        if self.density is not None and self.length is None:
+            raise ValueError("density: needs a trace-length distribution ([geometry.joints.dfn.length]); "
+                             "persistent traces are set by their spacing")
+        return self
+
+
+class JointSetConfig(_Strict):
+    """Pre-existing joints: lines embedded in the mesh whose interfaces get the joint's spring properties
+    (docs/joints.md)."""
+
+    name: str | None = Field(None, pattern=r"^[A-Za-z0-9_\-]+$", description="Name of the set; default 'joint<i>'.")
+    segments: list[tuple[Point, Point]] | None = Field(
+        None, description="Given joint traces, each [[x0, y0], [x1, y1]] [m]. Clipped to the domain (a trace "
+        "across the whole domain may end outside it); a trace wholly outside, of zero length, along the domain "
+        "boundary or closer than `borehole_clearance` to a borehole is an error. Give segments or dfn.",
+    )
+    dfn: JointNetworkConfig | None = Field(None, description="`[geometry.joints.dfn]`: a generated network instead "
+                                           "of given segments.")
+    tensile_strength: float = Field(0.0, ge=0, description="Tensile strength of the joint's springs [Pa]; 0: "
+                                    "the joint opens as soon as it is not in compression.")
+    cohesion: float = Field(0.0, ge=0, description="Cohesion of the joint's springs [Pa].")
+    friction_angle: float = Field(30.0, ge=0, lt=90, description="Friction angle φ_j of the joint [deg], in [0, 90).")
+    residual_friction_angle: float | None = Field(
+        None, ge=0, lt=90, description="Friction angle of the joint once broken (or open) [deg]; default "
+        "friction_angle. The node-to-edge block contact of faces that have slid or opened by more than half an "
+        "element keeps the rock's residual friction.",
+    )
+    kn: float | None = Field(None, gt=0, description="Normal stiffness of the joint per unit area [Pa/m]; default "
+                             "that of the rock's springs at the same interface.")
+    ks: float | None = Field(None, gt=0, description="Shear stiffness of the joint per unit area [Pa/m]; default "
+                             "that of the rock's springs at the same interface.")
+    open: bool = Field(False, description="The joint's springs are broken from t = 0 (pair_mode 1): its faces "
+                       "interact by frictional contact only (residual_friction_angle), they carry no tension.")
+    mesh_size: float | None = Field(None, gt=0, description="Element size along the joint [m]; default "
+                                    "geometry.mesh_size; at most geometry.mesh_size.")
+    borehole_clearance: float | None = Field(
+        None, gt=0, description="Smallest distance from a joint to a borehole wall [m]; default the joint's mesh "
+        "size. Generated traces are cut back to it; a given segment closer than it is an error.",
+    )
+
+    @model_validator(mode="after")
+    def _source(self) -> "JointSetConfig":
+        if (self.segments is None) == (self.dfn is None):
+            raise ValueError("segments: give exactly one of segments (given traces) and dfn (a generated network)")
+        if self.segments is not None and not self.segments:
+            raise ValueError("segments: empty list; give at least one segment [[x0, y0], [x1, y1]]")
+        return self
+
+    @property
+    def residual_friction(self) -> float:
+        """Residual friction angle of the joint [deg] (defaults to friction_angle)."""
+        return self.friction_angle if self.residual_friction_angle is None else self.residual_friction_angle
+
+
 class GeometryConfig(_Strict):
     """Rock domain, boreholes and mesh sizes (meshed by gmsh) or an external .msh file."""
 
@@ -379,6 +501,10 @@ class GeometryConfig(_Strict):
     mesh_algorithm: Literal["delaunay", "frontal-delaunay"] = Field(
         "delaunay",
         description="gmsh 2D algorithm; plain Delaunay gives a less regular mesh, so cracks are less biased to lattice directions.",
+    )
+    joints: list[JointSetConfig] = Field(
+        default_factory=list, description="`[[geometry.joints]]`: pre-existing joint sets (given segments or a "
+        "generated network) embedded in the mesh, whose interfaces get joint properties (docs/joints.md).",
     )
 
     @field_validator("mesh_file")
@@ -405,7 +531,18 @@ class GeometryConfig(_Strict):
                                      f"radii {bi.radius} and {bj.radius} m); boreholes must be apart")
         if self.mesh_size_near is not None and self.mesh_size_near > self.mesh_size:
             raise ValueError(f"mesh_size_near: must not exceed mesh_size ({self.mesh_size_near} > {self.mesh_size} m)")
+        if self.joints:
+            from ..geometry.joints import check_joint_config
+
+            check_joint_config(self)
         return self
+
+    def joint_mesh_size(self, i: int) -> float:
+        """Element size along joint set i [m] (its mesh_size, default geometry.mesh_size)."""
+        return self.joints[i].mesh_size or self.mesh_size
+
+    def joint_name(self, i: int) -> str:
+        return self.joints[i].name or f"joint{i}"
 
 
 # --------------------------------------------------------------------------- loads
@@ -753,6 +890,11 @@ class Scenario(_Strict):
                     raise ValueError(f"monitors[{i}] ({m.name}) at {m.position} is outside the domain")
             if self.explosive is not None:
                 _explosive_fits_rock(self.explosive, self.geometry)
+        if any(js.dfn is not None for js in self.geometry.joints):
+            # draw the networks once, so that a set that cannot be placed is reported at load time
+            from ..geometry.joints import check_joint_network
+
+            check_joint_network(self.geometry, self.simulation.seed)
         return self
 
     def boundary(self, side: str) -> BoundarySide:
