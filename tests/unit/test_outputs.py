@@ -266,3 +266,32 @@ def test_max_steps_bounds_the_insitu_stage_and_non_convergence_warns(tmp_path, c
     assert s["insitu_stage"]["steps"] == 400 and not s["insitu_stage"]["converged"]
     assert any("did not converge" in w for w in s["warnings"])
     assert "did not converge" in capsys.readouterr().err
+
+
+def test_a_full_disk_ends_in_one_clear_message(tmp_path, monkeypatch, capsys):
+    """ENOSPC while writing the results: exit 2 with one line naming the directory, no traceback, and no file
+    left half-written (the writes are atomic)."""
+    import errno
+
+    from blastfrac.io import atomic
+
+    d = _scenario(tmp_path)
+    scen = tmp_path / "s.toml"
+    scen.write_text(tomli_w.dumps(d))
+    real = atomic.write_text_atomic
+    calls = {"n": 0}
+
+    def full(path, text):
+        calls["n"] += 1
+        if str(path).endswith("summary.json"):
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return real(path, text)
+
+    monkeypatch.setattr(atomic, "write_text_atomic", full)
+    import blastfrac.io.tables as tables
+
+    monkeypatch.setattr(tables, "write_text_atomic", full)
+    rc = main(["run", str(scen), "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "No space left on device" in err and "Traceback" not in err
+    assert not list((tmp_path / "out").glob("*.tmp*"))

@@ -66,6 +66,11 @@ def run(args) -> int:
         return e.exit_code
     except ValueError as e:                     # a checkpoint of another scenario
         raise ScenarioError(str(e)) from None
+    except OSError as e:                        # read-only or full output directory: one clear line, exit 2
+        where = e.filename or sim.out_dir
+        raise ScenarioError(f"cannot write the results in {sim.out_dir} ({e.strerror or e} at {where}); every file "
+                            "is written whole or not at all, so what is there is complete; free space or give "
+                            "another --out") from None
     b = s["broken_springs"]
     print(f"{s['steps']} steps, t = {s['simulated_time'] * 1e6:.2f} µs, wall {s['wall_time_s']:.1f} s; "
           f"broken springs {b['total']} (tensile {b['tensile']}, shear {b['shear']}) of {s['counts']['springs']}; "
