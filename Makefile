@@ -35,6 +35,7 @@ validate: $(VENV)/.installed-test
 	for s in $(EXAMPLES); do $(BIN)/blastfrac run $$s || exit 1; done
 	$(BIN)/python examples/confined_blast/compare.py --out out/confined_blast_compare
 	$(BIN)/python examples/rock_fronts/candidates.py --out out/rock_fronts
+	$(BIN)/python examples/charge_resolution/study.py --out out/charge_resolution
 
 ## bench: performance suite (throughput and scaling), results printed and appended to benchmarks/
 bench: $(VENV)/.installed
