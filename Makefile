@@ -21,9 +21,9 @@ demo: $(VENV)/.installed
 	$(BIN)/blastfrac run $(DEMO) --out out/demo
 	@echo "figures: out/demo/fracture_pattern.png out/demo/displacement_snapshots.png out/demo/gas_pressure.png out/demo/*.png"
 
-## test: install the test extras and run the test suite (no slow tests)
+## test: install the test extras and run the test suite (no slow tests) on two worker processes
 test: $(VENV)/.installed-test
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2
 
 EXAMPLES := examples/circular_rock/scenario.toml examples/single_hole/scenario.toml \
             examples/confined_blast/scenario_P0.toml examples/confined_blast/scenario_P15.toml \
