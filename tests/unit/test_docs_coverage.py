@@ -7,6 +7,8 @@ from pathlib import Path
 from pydantic import BaseModel
 
 import blastfrac.scenario.explosive as explosive
+import blastfrac.scenario.geometry_config as geometry_config
+import blastfrac.scenario.pulses as pulses
 import blastfrac.scenario.schema as schema
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scenario.md"
@@ -15,7 +17,7 @@ DOC = Path(__file__).resolve().parents[2] / "docs" / "scenario.md"
 def test_every_scenario_field_has_a_row_in_docs_scenario_md():
     text = DOC.read_text()
     missing = []
-    for mod in (schema, explosive):
+    for mod in (schema, geometry_config, pulses, explosive):
         for name, cls in vars(mod).items():
             if not (inspect.isclass(cls) and issubclass(cls, BaseModel) and cls.__module__ == mod.__name__):
                 continue
