@@ -1,0 +1,378 @@
+"""Block contact, the per-node fan cache of held broken faces: candidates and exclusion masks rebuilt only where a
+spring changed, the search of a held node's own vertex, and the lean listing pass of the nodes with anything to
+do (cdem/contact.py, "Cost")."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from .contact_geometry import (
+    FAN_CACHE,
+    WEDGE_TOL,
+    XI_TOL,
+    consider_edge,
+    edge_coords,
+    fan_exclusions,
+    in_mask,
+    slot_end,
+    slot_exposed,
+    slot_open,
+    slot_prev,
+    vec5d,
+)
+
+
+@wp.func
+def corner_inside(
+    xn: wp.vec2d, other: wp.int32, ex1: bool, ex2: bool, x: wp.array(dtype=wp.vec2d), touch_tol: wp.float64,
+):
+    """True if xn is behind both exposed edges of other's element at other's vertex (within touch_tol): the
+    cheap sign test of the held-face search, done before the full evaluation (module doc, "Cost")."""
+    zero = wp.float64(0.0)
+    sb = slot_prev(other)
+    xc = x[other]
+    t1 = x[slot_end(other)] - xc
+    t2 = xc - x[sb]
+    r1 = xn - xc
+    r2 = xn - x[sb]
+    c1 = t1[1] * r1[0] - t1[0] * r1[1]
+    c2 = t2[1] * r2[0] - t2[0] * r2[1]
+    tol2 = touch_tol * touch_tol
+    inside1 = (not ex1) or c1 <= zero or c1 * c1 <= tol2 * wp.dot(t1, t1)
+    inside2 = (not ex2) or c2 <= zero or c2 * c2 <= tol2 * wp.dot(t2, t2)
+    return inside1 and inside2
+
+
+@wp.func
+def edge_may_take(xn: wp.vec2d, xa: wp.vec2d, xb: wp.vec2d, e1: wp.vec2d, e2: wp.vec2d):
+    """False only if consider_edge certainly rejects edge a→b for a node at xn whose element's edges at the node
+    are e1, e2 (not normalised): xn projects outside the edge (ξ beyond XI_TOL) or the node's element faces away
+    from it (wedge test). Without square roots or divisions; its margins (1e-12 of |r|·|ab|, 1e-6 of the wedge
+    threshold) are far above the round-off of either form, so it never rejects what consider_edge would take."""
+    ab = xb - xa
+    r = xn - xa
+    l2 = wp.dot(ab, ab)
+    slack = wp.float64(1.0e-12) * (wp.dot(r, r) + l2)           # ≥ 1e-12·|r|·|ab|
+    d = wp.dot(r, ab)                                            # ξ·|ab|²
+    if d < -XI_TOL * l2 - slack or d > (wp.float64(1.0) + XI_TOL) * l2 + slack:
+        return False
+    nrm = wp.vec2d(ab[1], -ab[0])                                # outward normal times |ab|
+    w2 = WEDGE_TOL * WEDGE_TOL * (wp.float64(1.0) - wp.float64(1.0e-6)) * l2
+    w1 = wp.dot(e1, nrm)
+    if w1 > wp.float64(0.0) and w1 * w1 > w2 * wp.dot(e1, e1):
+        return True
+    w = wp.dot(e2, nrm)
+    return w > wp.float64(0.0) and w * w > w2 * wp.dot(e2, e2)
+
+
+@wp.func
+def corner_consider(
+    other: wp.int32, ex1: bool, ex2: bool, xn: wp.vec2d, u1: wp.vec2d, u2: wp.vec2d,
+    x: wp.array(dtype=wp.vec2d), slot_iface: wp.array(dtype=wp.int32), pair_mode: wp.array(dtype=wp.int32),
+    st: vec5d, max_depth: wp.float64, touch_tol: wp.float64,
+):
+    """consider_edge for the exposed edges of other's element at the vertex (a node inside that corner)."""
+    sb = slot_prev(other)
+    xc = x[other]
+    out = st
+    if ex1:
+        out = consider_edge(other, edge_coords(xn, xc, x[slot_end(other)]), sb, xn, u1, u2,
+                            x, slot_iface, pair_mode, out, max_depth, touch_tol)
+    if ex2:
+        out = consider_edge(sb, edge_coords(xn, x[sb], xc), other, xn, u1, u2, x,
+                            slot_iface, pair_mode, out, max_depth, touch_tol)
+    return out
+
+
+@wp.func
+def fan_cache_build(
+    n: wp.int32,
+    excl: wp.int64,
+    node_vertex: wp.array(dtype=wp.int32),
+    vertex_start: wp.array(dtype=wp.int32),
+    vertex_nodes: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+):
+    """Cache the fan candidates of node n: the nodes at its vertex, in vertex order, of another element, not in
+    its exclusion mask excl and with an exposed edge at the vertex, as 4·node + (1 if its edge 'node' is
+    exposed) + (2 if its edge ending at the node is); fan_count −1 if more than FAN_CACHE (walk the fan)."""
+    e = n // 3
+    vtx = node_vertex[n]
+    k = wp.int32(0)
+    for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+        other = vertex_nodes[j]
+        if other // 3 != e:
+            if not in_mask(excl, other, fan_index):
+                code = wp.int32(0)
+                if slot_exposed(other, slot_iface, pair_mode):
+                    code = code + 1
+                if slot_exposed(slot_prev(other), slot_iface, pair_mode):
+                    code = code + 2
+                if code != 0:
+                    if k < FAN_CACHE:
+                        fan_cand[n, k] = 4 * other + code
+                    k = k + 1
+    if k > FAN_CACHE:
+        k = wp.int32(-1)
+    fan_count[n] = k
+
+
+@wp.func
+def held_search(
+    n: wp.int32,
+    excl: wp.int64,
+    use_cache: wp.int32,
+    node_vertex: wp.array(dtype=wp.int32),
+    vertex_start: wp.array(dtype=wp.int32),
+    vertex_nodes: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    max_depth: wp.float64,
+    touch_tol: wp.float64,
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+):
+    """Search state (consider_edge) of held node n: the other blocks at its own vertex only (module doc). With
+    use_cache, over its cached fan candidates (fan_cache_build: the same nodes in the same order, so the same
+    result); otherwise, or if the fan overflowed the cache, by walking the vertex's node list."""
+    e = n // 3
+    zero = wp.float64(0.0)
+    xn = x[n]
+    st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
+    # the node's element wedge (unit vectors along its two edges at the node), only once a corner test passes
+    have_u = bool(False)
+    u1 = wp.vec2d(zero, zero)
+    u2 = wp.vec2d(zero, zero)
+    cnt = wp.int32(-1)
+    if use_cache != 0:
+        cnt = fan_count[n]
+    if cnt >= 0:
+        for k in range(cnt):
+            code = fan_cand[n, k]
+            other = code >> 2
+            ex1 = (code & 1) != 0
+            ex2 = (code & 2) != 0
+            if corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                if not have_u:
+                    u1 = wp.normalize(x[slot_end(n)] - xn)
+                    u2 = wp.normalize(x[slot_prev(n)] - xn)
+                    have_u = True
+                st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st, max_depth, touch_tol)
+    else:
+        vtx = node_vertex[n]
+        for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+            other = vertex_nodes[j]
+            if other // 3 != e:
+                if not in_mask(excl, other, fan_index):
+                    ex1 = slot_exposed(other, slot_iface, pair_mode)
+                    ex2 = slot_exposed(slot_prev(other), slot_iface, pair_mode)
+                    # only a node inside the corner (behind both exposed edges) can be a contact: a cheap sign
+                    # test first, the full evaluation for the few that pass
+                    if ex1 or ex2:
+                        if corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                            if not have_u:
+                                u1 = wp.normalize(x[slot_end(n)] - xn)
+                                u2 = wp.normalize(x[slot_prev(n)] - xn)
+                                have_u = True
+                            st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st,
+                                                 max_depth, touch_tol)
+    return st
+
+
+@wp.kernel
+def mark_pair_changes(
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+    pair_vertex: wp.array(dtype=wp.int32),
+    step: wp.int32,
+    seen_mode: wp.array(dtype=wp.int32),
+    seen_dropped: wp.array(dtype=wp.int32),
+    vertex_stamp: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    dirty_vertices: wp.array(dtype=wp.int32),
+    iface_slots: wp.array(dtype=wp.vec2i),
+    slot_samples: wp.array(dtype=wp.vec2i),
+    sample_pos: wp.array(dtype=wp.int32),
+    sorted_code: wp.array(dtype=wp.int32),
+):
+    """List (once each, counts[0] of them) the vertices whose fan caches a change of spring p's state since the
+    last call makes stale: both ends of p's interface (the exposure of its edges counts at both vertices, the
+    exclusion chains at p's own); and the sorted_code sign of the hash points on the interface's two edges."""
+    p = wp.tid()
+    mode = pair_mode[p]
+    dropped = pair_dropped[p]
+    if mode != seen_mode[p] or dropped != seen_dropped[p]:
+        seen_mode[p] = mode
+        seen_dropped[p] = dropped
+        q = p // 2
+        for k in range(2):
+            vtx = pair_vertex[2 * q + k]
+            if wp.atomic_exch(vertex_stamp, vtx, step) != step:
+                dirty_vertices[wp.atomic_add(counts, 0, 1)] = vtx
+        exposed = pair_mode[2 * q] != 0 and pair_mode[2 * q + 1] != 0
+        for k in range(2):
+            sl = iface_slots[q][k]
+            code = -(sl + 1)
+            if exposed:
+                code = sl + 1
+            rng = slot_samples[sl]
+            for i in range(rng[0], rng[0] + rng[1]):
+                sorted_code[sample_pos[i]] = code
+
+
+@wp.func
+def node_faces(
+    n: wp.int32,
+    slot_iface: wp.array(dtype=wp.int32),
+    slot_l0: wp.array(dtype=wp.float64),
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+):
+    """(tributary length [m], 1 if open) of node n. The tributary length is half of each exposed edge of the
+    node's own element at the node; 0: not a candidate (edges only ever become exposed, so such a node never
+    had a contact). Open: one of those edges is a mesh-boundary edge or an interface with a dropped pair."""
+    zero = wp.float64(0.0)
+    half = wp.float64(0.5)
+    sp = slot_prev(n)
+    trib = zero
+    if slot_exposed(n, slot_iface, pair_mode):
+        trib = trib + half * slot_l0[n]
+    if slot_exposed(sp, slot_iface, pair_mode):
+        trib = trib + half * slot_l0[sp]
+    is_open = zero
+    if trib != zero:
+        if slot_open(n, slot_iface, pair_dropped) or slot_open(sp, slot_iface, pair_dropped):
+            is_open = wp.float64(1.0)
+    return wp.vec2d(trib, is_open)
+
+
+@wp.func
+def node_woken(e: wp.int32, elem_near: wp.array(dtype=wp.int32), step: wp.int32, near_window: wp.int32):
+    """True if an open face came near element e in the last near_window steps. Flags set in this step are not
+    read until the next one (a block woken again earlier in this step's pass reads as not woken)."""
+    return elem_near[e] >= step - near_window and elem_near[e] < step
+
+
+@wp.kernel
+def refresh_fan_cache(
+    refresh_all: wp.int32,
+    counts: wp.array(dtype=wp.int32),
+    dirty_vertices: wp.array(dtype=wp.int32),
+    node_vertex: wp.array(dtype=wp.int32),
+    vertex_start: wp.array(dtype=wp.int32),
+    vertex_nodes: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    slot_l0: wp.array(dtype=wp.float64),
+    node_pairs: wp.array(dtype=wp.vec2i),
+    pair_i: wp.array(dtype=wp.int32),
+    pair_j: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+    node_face: wp.array(dtype=wp.vec2d),
+    node_flag: wp.array(dtype=wp.int32),
+    fan_excl: wp.array(dtype=wp.int64),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+):
+    """Rebuild the caches (node_faces and node_flag, fan_exclusions mask, fan_cache_build list) of every node at
+    a listed vertex (every vertex with refresh_all): each thread writes only its own vertex's nodes, from the
+    spring states, so the order of the threads does not matter."""
+    i = wp.tid()
+    vtx = i
+    if refresh_all == 0:
+        if i >= counts[0]:
+            return
+        vtx = dirty_vertices[i]
+    for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+        n = vertex_nodes[j]
+        nf = node_faces(n, slot_iface, slot_l0, pair_mode, pair_dropped)
+        node_face[n] = nf
+        flag = wp.int32(0)                        # 0 no exposed edge, 1 held, 2 open
+        if nf[0] != wp.float64(0.0):
+            flag = 1
+            if nf[1] != wp.float64(0.0):
+                flag = 2
+        node_flag[n] = flag
+        ex = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
+        fan_excl[n] = ex
+        fan_cache_build(n, ex, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface, pair_mode,
+                        fan_cand, fan_count)
+
+
+@wp.kernel
+def list_candidates(node_flag: wp.array(dtype=wp.int32), cand_count: wp.array(dtype=wp.int32),
+                    cand_list: wp.array(dtype=wp.int32)):
+    """The nodes with an exposed edge at them (node_flag ≠ 0), in node order on a CPU: select_contact_nodes runs
+    over them only. Rebuilt when refresh_fan_cache has changed a flag."""
+    n = wp.tid()
+    if node_flag[n] != 0:
+        cand_list[wp.atomic_add(cand_count, 0, 1)] = n
+
+
+@wp.kernel
+def select_contact_nodes(
+    cand_list: wp.array(dtype=wp.int32),
+    cand_count: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    touch_tol: wp.float64,
+    step: wp.int32,
+    near_window: wp.int32,
+    held_faces: wp.int32,
+    elem_near: wp.array(dtype=wp.int32),
+    query_after: wp.array(dtype=wp.int32),
+    contact_slot: wp.array(dtype=wp.int32),
+    node_flag: wp.array(dtype=wp.int32),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    node_list: wp.array(dtype=wp.int32),
+):
+    """List (counts[1] of them, in node order on a CPU) the nodes of cand_list eval_block_contact has anything
+    to do for; it would leave the others without a write (from the caches: node_flag, fan candidates). A held node without
+    contact is listed only if one of its fan candidates passes the corner sign test (held_search makes the same
+    test first and finds nothing otherwise) and one of that corner's exposed edges passes edge_may_take."""
+    i = wp.tid()
+    if i >= cand_count[0]:
+        return
+    n = cand_list[i]
+    flag = node_flag[n]
+    if flag == 0:
+        return
+    is_open = flag == 2
+    woken = node_woken(n // 3, elem_near, step, near_window)
+    if not (is_open or woken):
+        if contact_slot[n] < 0:
+            if held_faces == 0:
+                return                            # held broken faces not searched (BlockContact.held_faces)
+            cnt = fan_count[n]
+            if cnt >= 0:
+                xn = x[n]
+                hit = bool(False)
+                for k in range(cnt):
+                    code = fan_cand[n, k]
+                    other = code >> 2
+                    ex1 = (code & 1) != 0
+                    ex2 = (code & 2) != 0
+                    if not hit and corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                        # the corner's exposed edges: can consider_edge take either? (edge_may_take)
+                        e1 = x[slot_end(n)] - xn
+                        e2 = x[slot_prev(n)] - xn
+                        xc = x[other]
+                        sb = slot_prev(other)
+                        if ex1:
+                            hit = edge_may_take(xn, xc, x[slot_end(other)], e1, e2)
+                        if ex2 and not hit:
+                            hit = edge_may_take(xn, x[sb], xc, e1, e2)
+                if not hit:
+                    return
+    # an open node whose last search found nothing within reach skips the search (BlockContact doc)
+    elif is_open and not woken and step < query_after[n] and contact_slot[n] < 0:
+        return
+    node_list[wp.atomic_add(counts, 1, 1)] = n

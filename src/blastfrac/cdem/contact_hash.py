@@ -1,0 +1,254 @@
+"""Block contact, the spatial hash of exposed-edge samples: sample points along the edges, a cell grid in
+wp.HashGrid's order with each cell's points and their edge's exposure, and the search of a node's hash cells
+(cdem/contact.py)."""
+
+from __future__ import annotations
+
+import warp as wp
+
+from .contact_geometry import (
+    consider_edge,
+    edge_coords,
+    in_mask,
+    slot_end,
+    slot_exposed,
+    slot_prev,
+    vec5d,
+    vec6d,
+)
+
+
+@wp.kernel
+def compute_edge_samples(
+    x: wp.array(dtype=wp.vec2d),
+    sample_slot: wp.array(dtype=wp.int32),
+    sample_frac: wp.array(dtype=wp.float64),
+    points: wp.array(dtype=wp.vec3d),
+):
+    """Hash points: each element edge is sampled at fixed fractions, at most ℓ_ref apart (see BlockContact)."""
+    i = wp.tid()
+    s = sample_slot[i]
+    xa = x[s]
+    m = xa + sample_frac[i] * (x[slot_end(s)] - xa)
+    points[i] = wp.vec3d(m[0], m[1], wp.float64(0.0))
+
+
+@wp.func
+def cell_coord(v: wp.float64):
+    """Cell coordinate of a scaled position, as wp.HashGrid computes it (floor, clamped to the int range)."""
+    c = wp.floor(v)
+    out = wp.int32(0)                                 # NaN
+    if c >= wp.float64(2147483646.0):
+        out = wp.int32(2147483646)
+    elif c >= wp.float64(-2147483648.0):
+        out = wp.int32(c)
+    elif c < wp.float64(-2147483648.0):
+        out = wp.int32(-2147483647) - wp.int32(1)
+    return out
+
+
+@wp.func
+def cell_wrap(c: wp.int32, dim: wp.int32):
+    """Physical cell of virtual cell coordinate c: non-negative modulo, as wp.HashGrid."""
+    r = c
+    if r < 0 or r >= dim:
+        r = c % dim
+        if r < 0:
+            r = r + dim
+    return r
+
+
+@wp.func
+def cell_end(start: wp.int32, end: wp.int32, dim: wp.int32):
+    """Last cell coordinate of a query, at most one pass over a dimension (as wp.HashGrid)."""
+    out = end
+    if wp.int64(end) - wp.int64(start) >= wp.int64(dim):
+        out = start + (dim - 1)
+    return out
+
+
+@wp.kernel
+def compute_sample_cells(
+    x: wp.array(dtype=wp.vec2d),
+    sample_slot: wp.array(dtype=wp.int32),
+    sample_frac: wp.array(dtype=wp.float64),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    cell_inv: wp.float64,
+    dim: wp.int32,
+    sample_xy: wp.array(dtype=wp.vec2d),
+    sample_code: wp.array(dtype=wp.int32),
+    keys: wp.array(dtype=wp.int32),
+    values: wp.array(dtype=wp.int32),
+):
+    """Hash points of the cell grid (BlockContact "Hash"): the same points as compute_edge_samples, their code
+    (slot + 1 on an exposed edge, −(slot + 1) on another) and their cell (its row-major index, the cell
+    wp.HashGrid puts them in) for the sort."""
+    i = wp.tid()
+    s = sample_slot[i]
+    xa = x[s]
+    m = xa + sample_frac[i] * (x[slot_end(s)] - xa)
+    sample_xy[i] = m
+    code = -(s + 1)
+    if slot_exposed(s, slot_iface, pair_mode):
+        code = s + 1
+    sample_code[i] = code
+    keys[i] = cell_wrap(cell_coord(m[1] * cell_inv), dim) * dim + cell_wrap(cell_coord(m[0] * cell_inv), dim)
+    values[i] = i
+
+
+@wp.kernel
+def gather_sample_cells(
+    keys: wp.array(dtype=wp.int32),
+    values: wp.array(dtype=wp.int32),
+    count: wp.int32,
+    sample_xy: wp.array(dtype=wp.vec2d),
+    sample_code: wp.array(dtype=wp.int32),
+    cell_starts: wp.array(dtype=wp.int32),
+    cell_ends: wp.array(dtype=wp.int32),
+    sorted_xy: wp.array(dtype=wp.vec2d),
+    sorted_code: wp.array(dtype=wp.int32),
+    sample_pos: wp.array(dtype=wp.int32),
+):
+    """After the (stable) sort by cell: each cell's range and its points in order, stored contiguously, with
+    their codes (mark_pair_changes keeps the sign of sorted_code up to date)."""
+    j = wp.tid()
+    c = keys[j]
+    i = values[j]
+    sorted_xy[j] = sample_xy[i]
+    sorted_code[j] = sample_code[i]
+    sample_pos[i] = j
+    if j == 0:
+        cell_starts[c] = j
+    elif keys[j - 1] != c:
+        cell_starts[c] = j
+    if j == count - 1:
+        cell_ends[c] = j + 1
+    elif keys[j + 1] != c:
+        cell_ends[c] = j + 1
+
+
+
+@wp.func
+def hash_edge(
+    s: wp.int32,
+    xn: wp.vec2d,
+    u1: wp.vec2d,
+    u2: wp.vec2d,
+    vtx: wp.int32,
+    excl: wp.int64,
+    is_open: bool,
+    node_vertex: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    max_depth: wp.float64,
+    touch_tol: wp.float64,
+    wake_dist: wp.float64,
+    step: wp.int32,
+    elem_near: wp.array(dtype=wp.int32),
+    sr: vec6d,
+):
+    """hash_search for one exposed edge s of another element within the search radius: sr = (search state of
+    consider_edge, distance to the closest edge). Wakes the edge's block if an open face comes near it."""
+    s_end = slot_end(s)
+    skip = bool(False)
+    corner = wp.int32(-1)
+    if node_vertex[s] == vtx:
+        skip = in_mask(excl, s, fan_index)
+        corner = slot_prev(s)
+    elif node_vertex[s_end] == vtx:
+        skip = in_mask(excl, s_end, fan_index)
+        corner = s_end
+    out = sr
+    if not skip:
+        c = edge_coords(xn, x[s], x[s_end])
+        st = consider_edge(s, c, corner, xn, u1, u2, x, slot_iface, pair_mode,
+                           vec5d(sr[0], sr[1], sr[2], sr[3], sr[4]), max_depth, touch_tol)
+        out = vec6d(st[0], st[1], st[2], st[3], st[4], wp.min(sr[5], c[2]))
+        if is_open and c[2] < wake_dist:
+            elem_near[s // 3] = step          # wake the block this open face comes near
+    return out
+
+
+@wp.func
+def hash_search(
+    n: wp.int32,
+    is_open: bool,
+    excl: wp.int64,
+    use_cache: wp.int32,
+    grid: wp.uint64,
+    points: wp.array(dtype=wp.vec3d),
+    sample_slot: wp.array(dtype=wp.int32),
+    cell_inv: wp.float64,
+    cell_dim: wp.int32,
+    cell_starts: wp.array(dtype=wp.int32),
+    cell_ends: wp.array(dtype=wp.int32),
+    sorted_xy: wp.array(dtype=wp.vec2d),
+    sorted_code: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    node_vertex: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    search_radius: wp.float64,
+    max_depth: wp.float64,
+    touch_tol: wp.float64,
+    wake_dist: wp.float64,
+    step: wp.int32,
+    quiet_steps: wp.int32,
+    elem_near: wp.array(dtype=wp.int32),
+    query_after: wp.array(dtype=wp.int32),
+):
+    """Search state (consider_edge) of an open or woken node n over every exposed edge near it, through the
+    spatial hash; excl: its fan_exclusions mask. Wakes the blocks an open face comes near and sets the node's
+    quiet period (BlockContact doc). With use_cache the points come from the cell grid (the cells wp.HashGrid
+    would visit, in its order, each cell's points in its order) with their exposure in sorted_code; without,
+    from wp.HashGrid itself."""
+    e = n // 3
+    zero = wp.float64(0.0)
+    xn = x[n]
+    vtx = node_vertex[n]
+    # the node's element wedge: unit vectors along its two edges at the node
+    u1 = wp.normalize(x[slot_end(n)] - xn)
+    u2 = wp.normalize(x[slot_prev(n)] - xn)
+    sr = vec6d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero, wp.float64(1.0e300))
+    r2 = search_radius * search_radius
+    if use_cache != 0:
+        xs = cell_coord((xn[0] - search_radius) * cell_inv)
+        xe = cell_end(xs, cell_coord((xn[0] + search_radius) * cell_inv), cell_dim)
+        ys = cell_coord((xn[1] - search_radius) * cell_inv)
+        ye = cell_end(ys, cell_coord((xn[1] + search_radius) * cell_inv), cell_dim)
+        for cy in range(ys, ye + 1):
+            row = cell_wrap(cy, cell_dim) * cell_dim
+            for cx in range(xs, xe + 1):
+                c = row + cell_wrap(cx, cell_dim)
+                for j in range(cell_starts[c], cell_ends[c]):
+                    code = sorted_code[j]
+                    if code > 0:                       # an exposed edge
+                        s = code - 1
+                        pt = sorted_xy[j]
+                        dx = pt[0] - xn[0]
+                        dy = pt[1] - xn[1]
+                        # whole hash cells: keep the points within the search radius
+                        if s // 3 != e and dx * dx + dy * dy <= r2:
+                            sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, node_vertex, fan_index, slot_iface,
+                                           pair_mode, x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
+    else:
+        query = wp.hash_grid_query(grid, wp.vec3d(xn[0], xn[1], zero), search_radius)
+        i = int(0)
+        while wp.hash_grid_query_next(query, i):
+            s = sample_slot[i]
+            p3 = points[i]
+            dx = p3[0] - xn[0]
+            dy = p3[1] - xn[1]
+            # the query returns whole hash cells: keep the points within the search radius
+            if s // 3 != e and dx * dx + dy * dy <= r2:
+                if slot_exposed(s, slot_iface, pair_mode):
+                    sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, node_vertex, fan_index, slot_iface, pair_mode,
+                                   x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
+    query_after[n] = 0
+    if is_open and sr[0] < zero and sr[5] >= wake_dist:
+        query_after[n] = step + quiet_steps
+    return vec5d(sr[0], sr[1], sr[2], sr[3], sr[4])
