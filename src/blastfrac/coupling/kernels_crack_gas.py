@@ -414,37 +414,26 @@ def crack_apply_flux(links: CrackLinks, gas: CrackGasState, parts: GasParticles)
         return
     a = links.a[k]
     b = links.b[k]
+    # d: granted mass from a to b (negative: from b to a), scaled by the donor's grant
+    s = F64(1.0)
     if dm > F64(0.0):
-        d = dm * gas.scale[a]
-        de = d * links.h[k]
-        wp.atomic_sub(gas.mass, a, d)
-        wp.atomic_sub(gas.energy, a, de)
-        if b >= 0:
-            wp.atomic_add(gas.mass, b, d)
-            wp.atomic_add(gas.energy, b, de)
-        else:
-            r = -b - 1
-            wp.atomic_add(parts.mass, r, d)
-            wp.atomic_add(parts.ie, r, de)
-            parts.touched[r] = 1
+        s = gas.scale[a]
+    elif b >= 0:
+        s = gas.scale[b]
     else:
-        s = F64(1.0)
-        if b >= 0:
-            s = gas.scale[b]
-        else:
-            s = parts.scale[-b - 1]
-        d = -dm * s
-        de = d * links.h[k]
-        wp.atomic_add(gas.mass, a, d)
-        wp.atomic_add(gas.energy, a, de)
-        if b >= 0:
-            wp.atomic_sub(gas.mass, b, d)
-            wp.atomic_sub(gas.energy, b, de)
-        else:
-            r = -b - 1
-            wp.atomic_sub(parts.mass, r, d)
-            wp.atomic_sub(parts.ie, r, de)
-            parts.touched[r] = 1
+        s = parts.scale[-b - 1]
+    d = dm * s
+    de = d * links.h[k]
+    wp.atomic_add(gas.mass, a, -d)
+    wp.atomic_add(gas.energy, a, -de)
+    if b >= 0:
+        wp.atomic_add(gas.mass, b, d)
+        wp.atomic_add(gas.energy, b, de)
+    else:
+        r = -b - 1
+        wp.atomic_add(parts.mass, r, d)
+        wp.atomic_add(parts.ie, r, de)
+        parts.touched[r] = 1
 
 
 @wp.kernel
