@@ -649,14 +649,22 @@ class Simulation:
         """(per-fragment arrays, summary report) of the present state (analysis/fragments.py)."""
         from .analysis.fragments import fragmentation_report, fragments
 
-        fr = fragments(self.model, self.state)
-        return fr, fragmentation_report(fr)
+        key = (self.steps, self.time)          # summary, fragments.csv and the figure read it at one state
+        cached = getattr(self, "_fragmentation_at", None)
+        if cached is None or cached[0] != key:
+            fr = fragments(self.model, self.state)
+            self._fragmentation_at = (key, (fr, fragmentation_report(fr)))
+        return self._fragmentation_at[1]
 
     def vibration(self) -> tuple[dict | None, dict | None]:
         """(summary.json → vibration, ring profile) from the nodes' PPV about the holes (analysis/ppv.py); (None,
         None) without a hole or charge to measure distances from."""
         from .analysis.ppv import vibration_report
 
+        key = (self.steps, self.time)
+        cached = getattr(self, "_vibration_at", None)
+        if cached is not None and cached[0] == key:
+            return cached[1]
         centres = self.crack_centres()
         if not centres:
             return None, None
@@ -668,6 +676,7 @@ class Simulation:
         if Q is None:
             rep["charge_per_hole"] = None
             rep["attenuation"]["law"] = "PPV = K R^-beta (no charge: R unscaled)"
+        self._vibration_at = (key, (rep, prof))
         return rep, prof
 
     def write_fragments(self) -> None:
