@@ -29,6 +29,20 @@ vibrating bar's period error converges at second order.  ``mirror[a]`` holds eac
 image across the walls normal to axis a (-1: none; the node itself: on the wall) and
 ``mirror_sign[a]`` the signs.  A wall that lies neither on a node nor half-way between two
 nodes, or a ghost whose image is not strictly inside, falls back to the plain condition.
+
+Active box.  The node loops (clearing, the momentum update, the remap velocity, the wall fold
+and ghosts) run over a box of nodes that holds the particles, not over the whole grid, so that a
+fine grid over a large rock costs what the gas touches.  ``Grid.box`` is (i0, j0, i1, j1), node
+indices inclusive; ``box_node`` maps a launch index to a node.  The box is the particles' stencil
+extent plus ``BOX_MARGIN`` cells and is renewed every ``BOX_STEPS`` steps from the extent that the
+particle update accumulates in ``extent`` (min i, min j, max i, max j of the stencil base cells
+since the last renewal).  A particle moves less than a cell per step (the CFL condition holds it
+to alpha h with alpha <= 0.5), so in ``BOX_STEPS`` steps it cannot leave a box with that margin;
+the renewal checks this on the accumulated extent, and a particle that broke it stops the run
+with an error rather than giving a silently wrong step.  Outside the box the node arrays keep
+whatever they last held: nothing reads them, because every particle's stencil lies inside, and
+a node that enters the box is cleared before its first P2G.  The results are bit-identical to
+the full-grid loops (tests/unit/test_grid_active_box.py).  A periodic axis keeps its full extent.
 """
 
 from __future__ import annotations
@@ -41,6 +55,17 @@ import warp as wp
 
 BC_X = 1
 BC_Y = 2
+
+#: steps between renewals of the active node box [-]
+BOX_STEPS = 5
+#: cells added to the particles' stencil extent on each side of the active box [-]: one per step
+#: to the next renewal (a particle moves less than a cell per step) plus two for wall images
+BOX_MARGIN = BOX_STEPS + 2
+_NO_EXTENT = (2**30, 2**30, -1, -1)
+
+
+class ActiveBoxError(RuntimeError):
+    """A material point crossed more than a cell per step and left the active node box."""
 
 
 @dataclass(frozen=True)
@@ -104,6 +129,51 @@ class Grid:
         self.mirror_axes: tuple[int, ...] = ()
         self._walls: list[tuple[int, int, float, str]] = []
         self._base_mask = np.zeros(n, dtype=np.int32)
+        # active box (module docstring): node indices, inclusive, and the particle extent since its renewal
+        self.box_i0, self.box_j0, self.box_i1, self.box_j1 = 0, 0, spec.nx - 1, spec.ny - 1
+        self.box_age = 0
+        self.extent = wp.array(np.array(_NO_EXTENT, dtype=np.int32), dtype=wp.int32, device=device)
+
+    # ------------------------------------------------------------------ active box
+    @property
+    def box(self) -> tuple[int, int, int, int]:
+        """(i0, j0, i1, j1): the active node box, inclusive node indices [-]."""
+        return self.box_i0, self.box_j0, self.box_i1, self.box_j1
+
+    @property
+    def box_node_count(self) -> int:
+        """Nodes in the active box [-] (the launch size of the node loops)."""
+        return (self.box_i1 - self.box_i0 + 1) * (self.box_j1 - self.box_j0 + 1)
+
+    def box_args(self) -> list:
+        """Kernel arguments (i0, j0, box width, nx) of :func:`box_node`."""
+        return [self.box_i0, self.box_j0, self.box_i1 - self.box_i0 + 1, self.spec.nx]
+
+    def renew_box(self, check: bool = True) -> None:
+        """Set the active box from the accumulated particle extent (plus ``BOX_MARGIN``) and restart the
+        accumulation.  With ``check``, first verify that the extent stayed inside the present box.
+
+        Reads four integers from the device (one synchronisation every ``BOX_STEPS`` steps on a GPU).
+        Raises :class:`ActiveBoxError` when a particle's stencil left the box since the last renewal.
+        """
+        s = self.spec
+        e0, f0, e1, f1 = (int(v) for v in self.extent.numpy())
+        self.box_age = 0
+        if e1 < 0:                      # no active particle: an empty-ish box (one node) keeps launches valid
+            self.box_i0, self.box_j0, self.box_i1, self.box_j1 = 0, 0, 0, 0
+            return
+        if check:
+            inside_x = s.periodic_x or (e0 >= self.box_i0 and e1 + 2 <= self.box_i1)
+            inside_y = s.periodic_y or (f0 >= self.box_j0 and f1 + 2 <= self.box_j1)
+            if not (inside_x and inside_y):
+                raise ActiveBoxError(
+                    f"a material point's stencil reached cells ({e0}..{e1 + 2}, {f0}..{f1 + 2}) outside the active "
+                    f"grid box ({self.box_i0}..{self.box_i1}, {self.box_j0}..{self.box_j1}) within {BOX_STEPS} "
+                    "steps: it moved more than a cell per step (the MPM time step is too large for the gas speed)")
+        m = BOX_MARGIN
+        self.box_i0, self.box_i1 = (0, s.nx - 1) if s.periodic_x else (max(0, e0 - m), min(s.nx - 1, e1 + 2 + m))
+        self.box_j0, self.box_j1 = (0, s.ny - 1) if s.periodic_y else (max(0, f0 - m), min(s.ny - 1, f1 + 2 + m))
+        self.extent.assign(np.array(_NO_EXTENT, dtype=np.int32))
 
     def set_walls(self, xmin=None, xmax=None, ymin=None, ymax=None, kind: str = "slip") -> None:
         """Walls at rest at the given coordinates [m]; kind 'slip' (normal velocity 0) or 'fixed' (both 0).

@@ -100,6 +100,17 @@ def g2p_velocity_apic(
     b_aff[p] = Bm
 
 
+@wp.func
+def accumulate_extent(xp: wp.vec2d, x0: wp.float64, y0: wp.float64, inv_h: wp.float64, extent: wp.array(dtype=wp.int32)):
+    """Widen ``extent`` (min i, min j, max i, max j) by the stencil base cell of a particle at xp [m]."""
+    bx = int(wp.floor((xp[0] - x0) * inv_h - F64(0.5)))
+    by = int(wp.floor((xp[1] - y0) * inv_h - F64(0.5)))
+    wp.atomic_min(extent, 0, bx)
+    wp.atomic_min(extent, 1, by)
+    wp.atomic_max(extent, 2, bx)
+    wp.atomic_max(extent, 3, by)
+
+
 @wp.kernel
 def update_particle_kinematics(
     active: wp.array(dtype=wp.int32),
@@ -122,10 +133,13 @@ def update_particle_kinematics(
     rho: wp.array(dtype=wp.float64),
     grad_v: wp.array(dtype=wp.mat22d),
     deactivated: wp.array(dtype=wp.int32),
+    extent: wp.array(dtype=wp.int32),
 ):
     """L_p = sum v_I (x) grad N_I (remapped v_I); V_p *= det(I + dt L); rho = m/V; x_p += dt v_pic.
 
-    A particle whose stencil leaves a non-periodic grid is deactivated (active = 0) and counted.
+    A particle whose stencil leaves a non-periodic grid is deactivated (active = 0) and counted.  The
+    stencil base cell at the new position widens ``extent`` (min i, min j, max i, max j), from which the
+    grid's active box is renewed (:mod:`blastfrac.mpm.grid`).
     """
     p = wp.tid()
     if active[p] == 0:
@@ -165,3 +179,20 @@ def update_particle_kinematics(
     if out != 0 or J <= F64(0.0):
         active[p] = 0
         wp.atomic_add(deactivated, 0, 1)
+        return
+    accumulate_extent(xn, x0, y0, inv_h, extent)
+
+
+@wp.kernel
+def particle_extent(
+    active: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    x0: wp.float64,
+    y0: wp.float64,
+    inv_h: wp.float64,
+    extent: wp.array(dtype=wp.int32),
+):
+    """Widen ``extent`` by every active particle's stencil base cell (the active box at construction)."""
+    p = wp.tid()
+    if active[p] != 0:
+        accumulate_extent(x[p], x0, y0, inv_h, extent)

@@ -1,5 +1,9 @@
 """Grid-node updates (METHOD §2.2 steps 2, 3 and the remap velocity), owner-computes, and the image-wall
-fold (atomic adds onto image nodes) and ghost update; see :mod:`blastfrac.mpm.grid`."""
+fold (atomic adds onto image nodes) and ghost update; see :mod:`blastfrac.mpm.grid`.
+
+Every node kernel runs over the grid's active box (launch size ``Grid.box_node_count``, arguments
+``Grid.box_args()``): launch index t is node :func:`box_node` (t).
+"""
 
 from __future__ import annotations
 
@@ -19,8 +23,37 @@ def apply_bc(v: wp.vec2d, mask: int, v_bc: wp.vec2d):
     return out
 
 
+@wp.func
+def box_node(t: int, i0: int, j0: int, bw: int, nx: int):
+    """Flat index of node t of the active box (row-major, width bw nodes, origin node (i0, j0)) [-]."""
+    return (j0 + t // bw) * nx + i0 + t % bw
+
+
+@wp.kernel
+def clear_grid_box(
+    i0: int,
+    j0: int,
+    bw: int,
+    nx: int,
+    with_mass_force: int,
+    g_mass: wp.array(dtype=wp.float64),
+    g_mom: wp.array(dtype=wp.vec2d),
+    g_force: wp.array(dtype=wp.vec2d),
+):
+    """Zero the momentum (and mass and force) of the active box's nodes before a P2G."""
+    n = box_node(wp.tid(), i0, j0, bw, nx)
+    g_mom[n] = wp.vec2d()
+    if with_mass_force != 0:
+        g_mass[n] = F64(0.0)
+        g_force[n] = wp.vec2d()
+
+
 @wp.kernel
 def update_grid_momentum(
+    i0: int,
+    j0: int,
+    bw: int,
+    nx: int,
     g_mass: wp.array(dtype=wp.float64),
     bc_mask: wp.array(dtype=wp.int32),
     bc_vel: wp.array(dtype=wp.vec2d),
@@ -32,7 +65,7 @@ def update_grid_momentum(
     g_dvel: wp.array(dtype=wp.vec2d),
 ):
     """p_I += dt f_I on nodes above the mass cut-off m_cut [kg/m]; writes v_I and the increment dv_I."""
-    n = wp.tid()
+    n = box_node(wp.tid(), i0, j0, bw, nx)
     m = g_mass[n]
     if m <= m_cut:
         g_mom[n] = wp.vec2d()
@@ -48,6 +81,10 @@ def update_grid_momentum(
 
 @wp.kernel
 def velocity_from_momentum(
+    i0: int,
+    j0: int,
+    bw: int,
+    nx: int,
     g_mass: wp.array(dtype=wp.float64),
     bc_mask: wp.array(dtype=wp.int32),
     bc_vel: wp.array(dtype=wp.vec2d),
@@ -56,7 +93,7 @@ def velocity_from_momentum(
     g_vel: wp.array(dtype=wp.vec2d),
 ):
     """v_I = p_I / m_I after the MUSL remap (0 below the cut-off), boundary conditions applied."""
-    n = wp.tid()
+    n = box_node(wp.tid(), i0, j0, bw, nx)
     m = g_mass[n]
     if m <= m_cut:
         g_vel[n] = wp.vec2d()
@@ -72,6 +109,10 @@ def cmul(a: wp.vec2d, b: wp.vec2d):
 
 @wp.kernel
 def fold_wall_images(
+    i0: int,
+    j0: int,
+    bw: int,
+    nx: int,
     mirror: wp.array(dtype=wp.int32),
     sign: wp.array(dtype=wp.vec2d),
     with_mass_force: int,
@@ -84,7 +125,7 @@ def fold_wall_images(
     A node on the wall is its own image (its odd components cancel, its mass doubles).  No race:
     a ghost is never an image, and a wall node is the image of itself only.
     """
-    n = wp.tid()
+    n = box_node(wp.tid(), i0, j0, bw, nx)
     k = mirror[n]
     if k < 0:
         return
@@ -103,6 +144,10 @@ def fold_wall_images(
 
 @wp.kernel
 def set_wall_ghosts(
+    i0: int,
+    j0: int,
+    bw: int,
+    nx: int,
     mirror: wp.array(dtype=wp.int32),
     sign: wp.array(dtype=wp.vec2d),
     g_mass: wp.array(dtype=wp.float64),
@@ -112,7 +157,7 @@ def set_wall_ghosts(
     g_mom: wp.array(dtype=wp.vec2d),
 ):
     """Image walls, after the node update: a ghost takes its image's velocity (and increment), signed [m/s]."""
-    n = wp.tid()
+    n = box_node(wp.tid(), i0, j0, bw, nx)
     k = mirror[n]
     if k < 0 or k == n:
         return

@@ -35,11 +35,17 @@ from blastfrac.mpm.apic import (
 )
 from blastfrac.mpm.burn import BURN_MODES
 from blastfrac.mpm.initiation import body_lighting_times
-from blastfrac.mpm.grid import Grid, GridSpec
+from blastfrac.mpm.grid import BOX_STEPS, Grid, GridSpec
 from blastfrac.mpm.kernels_burn import update_burn
 from blastfrac.mpm.kernels_eos import update_jwl_state
-from blastfrac.mpm.kernels_g2p import g2p_velocity, g2p_velocity_apic, update_particle_kinematics
-from blastfrac.mpm.kernels_grid import fold_wall_images, set_wall_ghosts, update_grid_momentum, velocity_from_momentum
+from blastfrac.mpm.kernels_g2p import g2p_velocity, g2p_velocity_apic, particle_extent, update_particle_kinematics
+from blastfrac.mpm.kernels_grid import (
+    clear_grid_box,
+    fold_wall_images,
+    set_wall_ghosts,
+    update_grid_momentum,
+    velocity_from_momentum,
+)
 from blastfrac.mpm.kernels_misc import max_signal_speed
 from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
 from blastfrac.mpm.seeding import charge_area_centroid, charge_bbox, seed_charges
@@ -234,6 +240,7 @@ class MPMSolver:
         else:
             self.cs.assign(np.full(n, material.p_wave_speed))
         self._check_in_grid(x)
+        self._init_active_box()
         self._geo = (
             float(spec.x0),
             float(spec.y0),
@@ -301,6 +308,14 @@ class MPMSolver:
         self.chem0 = ie.copy()
         self.light_time.fill_(np.inf)
 
+    def _init_active_box(self) -> None:
+        """The grid's active node box around the seeded particles (:mod:`blastfrac.mpm.grid`)."""
+        s = self.spec
+        self.grid.extent.assign(np.array([2**30, 2**30, -1, -1], dtype=np.int32))
+        wp.launch(particle_extent, dim=self.n, inputs=[self.active, self.x, F64(s.x0), F64(s.y0), F64(1.0 / s.h)],
+                  outputs=[self.grid.extent], device=self.device)
+        self.grid.renew_box(check=False)
+
     def _check_in_grid(self, x: np.ndarray) -> None:
         s = self.spec
         ok = np.ones(len(x), dtype=bool)
@@ -318,9 +333,8 @@ class MPMSolver:
     def to_grid(self, dt: float) -> None:
         """P2G (mass, momentum, forces incl. f_ext_p) at the current positions."""
         g = self.grid
-        g.mass.zero_()
-        g.mom.zero_()
-        g.force.zero_()
+        wp.launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 1], outputs=[g.mass, g.mom, g.force],
+                  device=self.device)
         wp.launch(
             p2g,
             dim=self.n,
@@ -336,8 +350,8 @@ class MPMSolver:
         g = self.grid
         wp.launch(
             update_grid_momentum,
-            dim=self.spec.node_count,
-            inputs=[g.mass, g.bc_mask, g.bc_vel, g.force, F64(dt), F64(self.m_cut)],
+            dim=g.box_node_count,
+            inputs=[*g.box_args(), g.mass, g.bc_mask, g.bc_vel, g.force, F64(dt), F64(self.m_cut)],
             outputs=[g.mom, g.vel, g.dvel],
             device=self.device,
         )
@@ -347,14 +361,16 @@ class MPMSolver:
         """Image walls: fold the ghosts' P2G sums onto their images, x walls then y walls."""
         g = self.grid
         for a in g.mirror_axes:
-            wp.launch(fold_wall_images, dim=self.spec.node_count, inputs=[g.mirror[a], g.mirror_sign[a], with_mass_force],
+            wp.launch(fold_wall_images, dim=g.box_node_count,
+                      inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], with_mass_force],
                       outputs=[g.mass, g.mom, g.force], device=self.device)
 
     def _wall_ghosts(self, with_dvel: int) -> None:
         """Image walls: ghosts take their images' velocities, x walls then y walls."""
         g = self.grid
         for a in g.mirror_axes:
-            wp.launch(set_wall_ghosts, dim=self.spec.node_count, inputs=[g.mirror[a], g.mirror_sign[a], g.mass, with_dvel],
+            wp.launch(set_wall_ghosts, dim=g.box_node_count,
+                      inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], g.mass, with_dvel],
                       outputs=[g.vel, g.dvel, g.mom], device=self.device)
 
     def to_particles(self, dt: float) -> None:
@@ -372,14 +388,15 @@ class MPMSolver:
                 outputs=[self.v, self.v_pic],
                 device=d,
             )
-        g.mom.zero_()
+        wp.launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 0], outputs=[g.mass, g.mom, g.force],
+                  device=d)
         wp.launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo],
                   outputs=[g.mom], device=d)
         self._fold_walls(0)
         wp.launch(
             velocity_from_momentum,
-            dim=self.spec.node_count,
-            inputs=[g.mass, g.bc_mask, g.bc_vel, g.mom, F64(self.m_cut)],
+            dim=g.box_node_count,
+            inputs=[*g.box_args(), g.mass, g.bc_mask, g.bc_vel, g.mom, F64(self.m_cut)],
             outputs=[g.vel],
             device=d,
         )
@@ -388,9 +405,12 @@ class MPMSolver:
             update_particle_kinematics,
             dim=self.n,
             inputs=[self.active, self.mass, g.vel, self.v_pic, *geo, F64(dt)],
-            outputs=[self.x, self.vol, self.vol_prev, self.rho, self.grad_v, self._deactivated],
+            outputs=[self.x, self.vol, self.vol_prev, self.rho, self.grad_v, self._deactivated, g.extent],
             device=d,
         )
+        g.box_age += 1
+        if g.box_age >= BOX_STEPS:
+            g.renew_box()
 
     def update_eos(self, dt: float, t: float) -> None:
         """Burn fraction at t + dt, then the material update (JWL products or elastic solid)."""
