@@ -50,11 +50,66 @@ def run(sizes=(100_000, 400_000, 1_600_000), steps: int = 20, device: str = "cpu
     return out
 
 
+def run_grid_size(widths=(0.06, 0.12, 0.24, 0.48), steps: int = 100, device: str = "cpu") -> list[dict]:
+    """A fixed small charge in ever larger grids: the cost of the active node box against the full-grid loops.
+
+    The demo's charge (emulsion, radius 5 mm, 0.5 mm cells = 20 across, 2 x 2 points per cell) centred in a
+    square grid of side ``widths`` [m]; ``steps`` MUSL steps after 20 of warm-up, timed once with the active
+    box and once with the box widened to the whole grid (what every node loop cost before).  Returns dicts
+    width_m, grid_nodes, box_nodes, particles, box_ms_per_step, full_ms_per_step.
+    """
+    import warp as wp
+
+    import blastfrac.mpm.grid as grid_mod
+    from blastfrac.mpm import MPMSolver
+    from blastfrac.scenario.explosive import ExplosiveConfig
+
+    out = []
+    margin0 = grid_mod.BOX_MARGIN
+    for w in widths:
+        row = {"width_m": w}
+        for label, margin in (("box", margin0), ("full", 10**9)):
+            grid_mod.BOX_MARGIN = margin
+            try:
+                cfg = ExplosiveConfig(name="emulsion", charges=[{"kind": "circle", "center": (0, 0), "radius": 0.005}],
+                                      grid={"cell_size": 5e-4, "points_per_cell": 2,
+                                            "bounds": ((-w / 2, -w / 2), (w / 2, w / 2))})
+                s = MPMSolver(cfg, device=device)
+                t, dt = 0.0, s.stable_dt()
+                for _ in range(20):
+                    s.step(dt, t)
+                    t += dt
+                wp.synchronize_device(s.device)
+                t0 = time.perf_counter()
+                for _ in range(steps):
+                    s.step(dt, t)
+                    t += dt
+                wp.synchronize_device(s.device)
+                row[f"{label}_ms_per_step"] = 1e3 * (time.perf_counter() - t0) / steps
+                row["grid_nodes"], row["particles"] = s.spec.node_count, s.n
+                if label == "box":
+                    row["box_nodes"] = s.grid.box_node_count
+            finally:
+                grid_mod.BOX_MARGIN = margin0
+        out.append(row)
+    return out
+
+
 def scaling_slope(rows: list[dict]) -> float:
     """Least-squares slope of log(wall per step) against log(n)."""
     n = np.log([r["n_particles"] for r in rows])
     w = np.log([r["wall_s"] / r["steps"] for r in rows])
     return float(np.polyfit(n, w, 1)[0])
+
+
+def grid_size_markdown(rows: list[dict]) -> str:
+    lines = ["| grid side [mm] | grid nodes | box nodes | particles | box [ms/step] | full grid [ms/step] | full / box |",
+             "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['width_m'] * 1e3:.0f} | {r['grid_nodes']:,} | {r['box_nodes']:,} | {r['particles']:,} | "
+                     f"{r['box_ms_per_step']:.3f} | {r['full_ms_per_step']:.3f} | "
+                     f"{r['full_ms_per_step'] / r['box_ms_per_step']:.2f} |")
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":
@@ -69,3 +124,4 @@ if __name__ == "__main__":
         print(f"{r['n_particles']:>10d} {r['steps']:>6d} {r['wall_s']:>9.3f} {r['particle_steps_per_s']:>17.3e}")
     if len(rows) > 1:
         print(f"scaling slope d log(wall)/d log(n) = {scaling_slope(rows):.3f}")
+    print(grid_size_markdown(run_grid_size(device=a.device)))

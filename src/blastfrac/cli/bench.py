@@ -62,6 +62,9 @@ def run(args) -> int:
         for r in rows:
             print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['particle_steps_per_s']:.3e} |")
         print(f"scaling slope: {_load('bench_cdem').scaling_slope(rows, 'n_particles'):.3f}")
+        widths = (0.06, 0.24) if args.quick else (0.06, 0.12, 0.24, 0.48)
+        print(f"\nMPM active node box on {device}: the demo's charge (1,257 points, 0.5 mm cells) in larger grids")
+        print(mpm.grid_size_markdown(mpm.run_grid_size(widths, steps=max(args.steps, 50), device=device)))
     if args.only == "coupled":
         cp = _load("bench_coupled")
         rows = []
