@@ -65,6 +65,7 @@ class Simulation:
 
         self.ppv = PeakVelocity(self.model.node_count, self.device)      # peak particle velocity per node
         self.gas_report: dict = {}
+        self.charge_mirror = 1.0        # whole charge over modelled charge (half and quarter models)
         if scenario.explosive is not None:
             self._build_explosive()
         self.dt = self._time_step()
@@ -100,21 +101,42 @@ class Simulation:
             X = self.model.host["node_X"]
             lo, hi = X.min(axis=0), X.max(axis=0)
             ex = ex.model_copy(update={"grid": ex.grid.model_copy(update={"bounds": (tuple(lo), tuple(hi))})})
+        lines = sc.geometry.symmetry_lines()          # half and quarter models: charges cut at the symmetry lines,
+        if lines:                                     # the grid's slip walls on them (mpm/seeding.py, grid_from_config)
+            from .mpm.seeding import cut_charges, fold_to_modelled_side, symmetry_cuts
+
+            full = sum(c.area for c in ex.charges)
+            ex = ex.model_copy(update={"charges": cut_charges(ex.charges, lines)})
+            self.charge_mirror = full / sum(c.area for c in ex.charges) if ex.charges else 1.0
         cp = sc.coupling
         spacing = ex.grid.cell_size / ex.grid.points_per_cell
         clearance = cp.wall_clearance * 0.5 * spacing
         removed = [0]
 
-        def keep_clear(x, vol):
-            x2, vol2, removed[0], keep = clear_from_rock(x, vol, self.model, clearance, return_mask=True)
+        def keep_clear(x, vol):                 # called for the charges' points, then for each elastic body's
+            x2, vol2, n_removed, keep = clear_from_rock(x, vol, self.model, clearance, return_mask=True)
+            if lines:                           # a point pushed off a wall across a symmetry line: its image
+                x2 = fold_to_modelled_side(x2, symmetry_cuts(ex.charges))
+            removed[0] += n_removed
             return x2, vol2, keep
 
+        if sc.crack_gas.enabled and not ex.charges:
+            raise ScenarioError("crack_gas.enabled: needs explosive.charges (the crack gas is the charges' products; "
+                                "this run has elastic bodies only)")
         self.gas = MPMSolver(ex, device=self.device, particle_filter=keep_clear)
         if self.gas.n == 0:
-            raise ScenarioError("explosive.charges: no material point left after clearing the rock; the charges must "
+            what = "charges" if ex.charges else "bodies"
+            raise ScenarioError(f"explosive.{what}: no material point left after clearing the rock; the {what} must "
                                 "lie in boreholes or outside the rock, at least one particle spacing wide")
-        cj = cj_report(self.gas.material, ex.name or "custom")
-        kc = cp.contact_stiffness or default_contact_stiffness(self.gas.p_cj, cp.stiffness_factor)
+        cj = cj_report(self.gas.material, ex.name or "custom") if self.gas.is_jwl else None
+        if cp.contact_stiffness:
+            kc = cp.contact_stiffness
+        elif self.gas.is_jwl:
+            kc = default_contact_stiffness(self.gas.p_cj, cp.stiffness_factor)
+        else:                                       # no charges: scaled on the stiffest body (mpm/bodies.py)
+            from .mpm.bodies import body_contact_stiffness
+
+            kc = body_contact_stiffness(self.gas.bodies, cp.stiffness_factor)
         self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval,
                                       force_cap=cp.force_cap, surface_forces=cp.surface_forces,
                                       pressure_preload=cp.pressure_preload)
@@ -135,6 +157,16 @@ class Simulation:
             "cell_size": self.gas.spec.h, "contact_stiffness": kc, "contact_dt": self.coupler.stable_dt(),
             "cj_check": cj,
         }
+        if ex.bodies:
+            self.gas_report["bodies"] = self._body_report(ex.bodies)
+
+    def _body_report(self, bodies) -> list[dict]:
+        """summary.json → explosive.bodies: each elastic body's name, points, mass [kg/m], P-wave speed [m/s],
+        impedance ρc_p [Pa·s/m] and initial velocity [m/s]."""
+        mass, bid = self.gas.mass.numpy(), self.gas.body_id
+        return [{"name": b.name or f"body{k}", "particles": int((bid == k).sum()), "mass": float(mass[bid == k].sum()),
+                 "p_wave_speed": b.p_wave_speed, "impedance": b.density * b.p_wave_speed,
+                 "velocity": list(b.velocity)} for k, b in enumerate(bodies)]
 
     def _time_step(self) -> float:
         """min(safety·Δt_rock, safety·Δt_contact, Δt_MPM) [s]; the MPM CFL factor is its own safety."""
@@ -335,6 +367,8 @@ class Simulation:
                        "external_work"]
         if self.gas is not None:
             energy_cols += ["explosive_released", "gas_internal", "gas_kinetic", "contact_energy"]
+            if self.gas.n_solid:
+                energy_cols += ["body_kinetic", "body_strain"]
             if self.crack_gas is not None:
                 energy_cols += ["crack_gas"]
         self._energy = CsvHistory(self.out_dir / "energy.csv", energy_cols + ["budget_error"], unit="J/m")
@@ -635,6 +669,10 @@ class Simulation:
             "status": "completed",
             "warnings": list(self.warnings),
         }
+        if self.scenario.geometry.symmetry:                # a half or quarter model (analysis/symmetry.py)
+            from .analysis.symmetry import symmetry_report
+
+            out["symmetry"] = symmetry_report(self.scenario)
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
                                 "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}
@@ -670,7 +708,8 @@ class Simulation:
             return None, None
         Q = None
         if self.gas is not None:
-            Q = float(self.gas.mass0_total) / len(centres)
+            # the whole hole's charge (a half or quarter model seeds its modelled part, analysis/symmetry.py)
+            Q = float(self.gas.mass0_total) * self.charge_mirror / len(centres) or None  # None: no charge
         rep, prof = vibration_report(self.model.host["node_X"], self.ppv.values(), centres, Q if Q else 1.0,
                                      self.scenario.rock)
         if Q is None:

@@ -66,7 +66,13 @@ def run(args) -> int:
         dt = sim.dt
         dt_rows = [("dt contact (x dt_safety)", f"{dt_c:.4e} s"),
                    ("dt MPM (CFL, at ignition)", f"{dt_g:.4e} s (changes with the gas speed during the run)"),
-                   ("gas particles", f"{sim.gas.n}")]
+                   ("gas particles", f"{sim.gas.n - sim.gas.n_solid}")]
+        for k, b in enumerate(sim.gas_report.get("bodies", [])):
+            eb = sc.explosive.bodies[k]
+            text = (f"{b['particles']} points, {b['mass']:.4g} kg/m, E {eb.youngs_modulus / 1e9:.4g} GPa, "
+                    f"nu {eb.poisson_ratio:.4g}, c_p {b['p_wave_speed']:.1f} m/s, "
+                    f"v ({eb.velocity[0]:.4g}, {eb.velocity[1]:.4g}) m/s")
+            dt_rows.append((f"elastic body {b['name']}", text))
         limit = min((("rock", sc.simulation.dt_safety * m.stable_dt), ("contact", dt_c), ("MPM", dt_g)),
                     key=lambda kv: kv[1])[0]
         dt_rows.append(("step limited by", limit))
@@ -104,11 +110,19 @@ def run(args) -> int:
         ("memory (model + state)", f"{(model_bytes(m) + state_bytes) / 2**20:.1f} MiB"),
         ("output directory", sc.output.directory),
     ]
+    if sc.geometry.symmetry:                  # a half or quarter model (docs/explosive.md)
+        from ..analysis.symmetry import describe
+
+        rows.append(("symmetry", describe(sc.geometry)))
     if sc.explosive is not None:
         from ..explosives.library import cj_report
 
-        rep = cj_report(sc.explosive.jwl(), sc.explosive.name or "custom")
-        rows.append(("explosive CJ check", rep["message"]))
+        jwl = sc.explosive.jwl()
+        if jwl is None:
+            rows.append(("explosive CJ check", "no charges (elastic bodies only): no JWL used"))
+        else:
+            rep = cj_report(jwl, sc.explosive.name or "custom")
+            rows.append(("explosive CJ check", rep["message"]))
     w = max(len(k) for k, _ in rows)
     print(f"scenario {args.scenario}: valid")
     for k, v in rows:

@@ -152,8 +152,64 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
         loop = [-a for a in reversed(arcs)] if reverse else arcs
         return g.addCurveLoop(loop)
 
+    def cut_loop(pieces) -> int:
+        """Curve loop of a rectangle whose sides are cut by boreholes (symmetry lines): ``pieces`` from
+        :func:`cut_boundary`, lines (split at joint points like ``polyline``) and arcs of at most π/2."""
+        pts: dict[tuple[float, float], int] = {}
+        centres: dict[tuple[float, float], int] = {}
+
+        def point(p, size):
+            key = (float(p[0]), float(p[1]))
+            if key not in pts:
+                pts[key] = g.addPoint(key[0], key[1], 0.0, size)
+            return pts[key]
+
+        curves = []
+        for pc in pieces:
+            if pc[0] == "line":
+                _, a, b, name = pc
+                chain = [point(a, pc_size(a))]
+                for k, t in _points_on_side(np.asarray(a), np.asarray(b), net, on_boundary):
+                    x, y = np.asarray(a) + t * (np.asarray(b) - np.asarray(a))
+                    joint_tag[k] = g.addPoint(x, y, 0.0, min(h, size_at[k]))
+                    chain.append(joint_tag[k])
+                chain.append(point(b, pc_size(b)))
+                for p0, p1 in zip(chain[:-1], chain[1:]):
+                    ln = g.addLine(p0, p1)
+                    side_curves.setdefault(name, []).append(ln)
+                    curves.append(ln)
+            else:
+                _, a, b, c, name, size = pc
+                if c not in centres:
+                    centres[c] = g.addPoint(c[0], c[1], 0.0, size)
+                arc = g.addCircleArc(point(a, size), centres[c], point(b, size))
+                side_curves.setdefault(name, []).append(arc)
+                curves.append(arc)
+        if net is not None and len(pts):
+            # a joint that ends at a corner of the domain shares the corner's point (as in polyline)
+            keys = np.array(list(pts), float)
+            tol = 1e-8 * float(np.ptp(keys, axis=0).max())
+            for k in net.boundary_points:
+                dv = np.linalg.norm(keys - net.points[k], axis=1)
+                if int(k) not in joint_tag and dv.min() <= tol:
+                    joint_tag[int(k)] = pts[tuple(keys[int(np.argmin(dv))])]
+        return g.addCurveLoop(curves)
+
+    hole_size = [b.mesh_size or h_near for b in geom.boreholes]
+
+    def pc_size(p) -> float:
+        """Size at a point of a cut rectangle's sides: the hole's where a hole meets the side, else h."""
+        for b, hs in zip(geom.boreholes, hole_size):
+            if abs(math.dist(p, b.center) - b.radius) <= 1e-9 * b.radius:
+                return hs
+        return h
+
     d = geom.domain
-    if isinstance(d, RectangleDomain):
+    cut = [i for i in range(len(geom.boreholes)) if geom.symmetry and geom.cut_sides(i)]
+    if isinstance(d, RectangleDomain) and cut:
+        outer = cut_loop(cut_boundary(d, [(geom.boreholes[i].center, geom.boreholes[i].radius, f"hole{i}",
+                                           hole_size[i]) for i in cut]))
+    elif isinstance(d, RectangleDomain):
         cx, cy, w2, h2 = d.center[0], d.center[1], d.width / 2, d.height / 2
         outer = polyline([(cx - w2, cy - h2), (cx + w2, cy - h2), (cx + w2, cy + h2), (cx - w2, cy + h2)],
                          ["bottom", "right", "top", "left"])
@@ -165,7 +221,7 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
         raise TypeError(type(d))
 
     holes = [circle(b.center, b.radius, f"hole{i}", b.mesh_size or h_near, reverse=True)
-             for i, b in enumerate(geom.boreholes)]
+             for i, b in enumerate(geom.boreholes) if i not in cut]
     joint_lines: list[tuple[int, int]] = []             # (gmsh curve tag, joint set)
     if net is not None:
         for k in range(len(net.points)):
@@ -252,6 +308,88 @@ def _mesh_with_gmsh(gmsh, geom: GeometryConfig, seed: int) -> TriMesh:
 
 #: a joint meshed finer than geometry.mesh_size grades to mesh_size over this many mesh_size from the joint
 JOINT_GRADING = 4.0
+
+
+def cut_boundary(d: RectangleDomain, holes) -> list[tuple]:
+    """The boundary of a rectangle minus discs that cross its sides (holes cut by symmetry lines), counter-clockwise.
+
+    ``holes``: (centre, radius, tag, mesh size) of each cutting disc; each must meet the rectangle's perimeter in one
+    stretch (it crosses one side, or two sides about their corner). Returns pieces ``("line", a, b, side)`` along the
+    sides and ``("arc", a, b, centre, tag, size)`` along the discs inside the rectangle, clockwise about their centre
+    and split at the multiples of π/2 about it (as a whole hole's four arcs), each at most π/2.
+    """
+    (x0, y0), (x1, y1) = d.bbox
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    names = ["bottom", "right", "top", "left"]
+    lengths = [x1 - x0, y1 - y0, x1 - x0, y1 - y0]
+    start = [0.0, lengths[0], lengths[0] + lengths[1], lengths[0] + lengths[1] + lengths[2]]
+    per = float(sum(lengths))
+
+    def covered(p) -> bool:
+        return any(math.dist(p, c) < r * (1 - 1e-12) for c, r, _, _ in holes)
+
+    # each disc's entry and exit on the perimeter: (perimeter coordinate s from (x0, y0), point)
+    spans = []
+    for c, r, tag, size in holes:
+        cross = []
+        for k in range(4):
+            a, b = np.asarray(corners[k], float), np.asarray(corners[(k + 1) % 4], float)
+            dv, f = b - a, a - np.asarray(c, float)
+            qa, qb, qc = dv @ dv, 2 * f @ dv, f @ f - r * r
+            disc = qb * qb - 4 * qa * qc
+            if disc <= 0:
+                continue
+            sq = math.sqrt(disc)
+            for t, entering in (((-qb - sq) / (2 * qa), True), ((-qb + sq) / (2 * qa), False)):
+                if 0.0 < t < 1.0:
+                    # exact coordinates on the side: the side's fixed coordinate is kept as given
+                    p = tuple(float(a[i] + t * dv[i]) if dv[i] else float(a[i]) for i in (0, 1))
+                    cross.append((start[k] + t * lengths[k], p, entering))
+        ins = [(sv, p) for sv, p, e in cross if e]
+        outs = [(sv, p) for sv, p, e in cross if not e]
+        if len(ins) != 1 or len(outs) != 1:
+            raise ValueError(f"geometry: {tag} must cut the rectangle's boundary in one stretch (one side, or two "
+                             "sides about their corner)")
+        spans.append((ins[0], outs[0], c, r, tag, size))
+    free = [k for k in range(4) if not covered(corners[k])]
+    s0 = start[free[0]]                                   # walk from a corner no disc covers
+    events = [((start[k] - s0) % per, "corner", k) for k in free[1:]]
+    events += [((sp[0][0] - s0) % per, "hole", j) for j, sp in enumerate(spans)]
+    events.sort(key=lambda ev: ev[0])
+    events.append((per, "end", free[0]))
+
+    def side_of(sa: float, sb: float) -> str:
+        m = (s0 + 0.5 * (sa + sb)) % per
+        return names[max(k for k in range(4) if start[k] <= m)]
+
+    pieces: list[tuple] = []
+    pos_s, pos = 0.0, corners[free[0]]
+    for s_ev, kind, j in events:
+        if kind == "hole":
+            (_, p_in), (s_out, p_out), c, r, tag, size = spans[j]
+            if s_ev - pos_s > 1e-12 * per:
+                pieces.append(("line", pos, p_in, side_of(pos_s, s_ev)))
+            pieces += _cw_arcs(p_in, p_out, c, r, tag, size)
+            pos_s, pos = (s_out - s0) % per, p_out
+        else:
+            q = corners[j]
+            if s_ev - pos_s > 1e-12 * per:
+                pieces.append(("line", pos, q, side_of(pos_s, s_ev)))
+            pos_s, pos = s_ev, q
+    return pieces
+
+
+def _cw_arcs(a, b, c, r: float, tag: str, size: float) -> list[tuple]:
+    """Arcs from a to b clockwise about c, split at the multiples of π/2 strictly between them."""
+    q = 0.5 * math.pi
+    ta = math.atan2(a[1] - c[1], a[0] - c[0])
+    sweep = (ta - math.atan2(b[1] - c[1], b[0] - c[0])) % (2 * math.pi)
+    eps = 1e-9
+    ks = [k for k in range(math.floor((ta - sweep) / q) - 1, math.ceil(ta / q) + 2)
+          if ta - sweep + eps < k * q < ta - eps]
+    mid = [(c[0] + r * math.cos(k * q), c[1] + r * math.sin(k * q)) for k in sorted(ks, reverse=True)]
+    pts = [a, *mid, b]
+    return [("arc", p, e, (float(c[0]), float(c[1])), tag, size) for p, e in zip(pts[:-1], pts[1:])]
 
 
 def _joint_point_sizes(geom: GeometryConfig, net) -> np.ndarray:

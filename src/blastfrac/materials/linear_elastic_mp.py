@@ -1,4 +1,9 @@
-"""Linear-elastic material-point model (plane strain) for the MPM core benchmarks (VALIDATION §5).
+"""Linear-elastic material-point model (plane strain): the MPM core benchmarks (VALIDATION §5) and the elastic
+bodies of a scenario (``[[explosive.bodies]]``, an impactor; :mod:`blastfrac.mpm.bodies`).
+
+The kernel that applies the law to the points is :func:`blastfrac.mpm.kernels_solid.update_elastic_state`: each
+point carries its own Lamé constants, so bodies of different materials and the detonation products share one grid
+and one launch per stage.
 
 Hypoelastic rate form with the Jaumann rate, integrated explicitly:
 
@@ -86,33 +91,3 @@ def stress_work_increment_np(sig_old, sig_new, vol_old, vol_new, L, dt):
     Dm = 0.5 * (L + np.swapaxes(L, -1, -2))
     vs = 0.5 * (np.asarray(vol_old)[..., None, None] * sig_old + np.asarray(vol_new)[..., None, None] * sig_new)
     return dt * (vs * Dm).sum(axis=(-1, -2))
-
-
-@wp.kernel
-def update_elastic_state(
-    active: wp.array(dtype=wp.int32),
-    grad_v: wp.array(dtype=wp.mat22d),
-    rho: wp.array(dtype=wp.float64),
-    vol_prev: wp.array(dtype=wp.float64),
-    vol: wp.array(dtype=wp.float64),
-    dt: wp.float64,
-    lam: wp.float64,
-    mu: wp.float64,
-    stress: wp.array(dtype=wp.mat22d),
-    pres: wp.array(dtype=wp.float64),
-    cs: wp.array(dtype=wp.float64),
-    work: wp.array(dtype=wp.float64),
-):
-    """Advance sigma [Pa]; p = -tr(sigma)/2 [Pa]; c = sqrt((lambda + 2 mu)/rho) [m/s]; stored work [J/m]."""
-    p = wp.tid()
-    if active[p] == 0:
-        return
-    L = grad_v[p]
-    s0 = stress[p]
-    s = elastic_stress_update(s0, L, dt, lam, mu)
-    Dm = F64(0.5) * (L + wp.transpose(L))
-    vs = F64(0.5) * (vol_prev[p] * s0 + vol[p] * s)
-    work[p] = work[p] + dt * wp.ddot(vs, Dm)
-    stress[p] = s
-    pres[p] = -F64(0.5) * (s[0, 0] + s[1, 1])
-    cs[p] = wp.sqrt((lam + F64(2.0) * mu) / rho[p])

@@ -6,6 +6,7 @@ import warp as wp
 
 from blastfrac.materials.artificial_viscosity import bulk_viscosity  # noqa: F401 (shared with the rock)
 from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq
+from blastfrac.mpm.bodies import MAT_GAS
 
 F64 = wp.float64
 
@@ -13,6 +14,7 @@ F64 = wp.float64
 @wp.kernel
 def update_jwl_state(
     active: wp.array(dtype=wp.int32),
+    kind: wp.array(dtype=wp.int32),
     vol0: wp.array(dtype=wp.float64),
     vol: wp.array(dtype=wp.float64),
     vol_prev: wp.array(dtype=wp.float64),
@@ -35,9 +37,10 @@ def update_jwl_state(
     cs: wp.array(dtype=wp.float64),
     stress: wp.array(dtype=wp.mat22d),
 ):
-    """Advance q, p [Pa], ie [J/m], c [m/s] and sigma = -(p + q) I of each products particle."""
+    """Advance q, p [Pa], ie [J/m], c [m/s] and sigma = -(p + q) I of each products particle (kind MAT_GAS;
+    elastic points are left alone)."""
     p = wp.tid()
-    if active[p] == 0:
+    if active[p] == 0 or kind[p] != MAT_GAS:
         return
     v0 = vol0[p]
     V = vol[p] / v0

@@ -1,4 +1,4 @@
-"""MPMSolver: explicit MUSL material point method for detonation products (METHOD §2).
+"""MPMSolver: explicit MUSL material point method for detonation products (METHOD §2) and elastic bodies.
 
 One step (``step``) is four stages that a coupled simulation may interleave:
 
@@ -9,7 +9,11 @@ One step (``step``) is four stages that a coupled simulation may interleave:
                           volume/density update, particle motion (particles leaving the grid
                           are deactivated);
 4. ``update_eos(dt, t)`` burn fraction at t + dt, artificial viscosity, JWL energy/pressure,
-                          sound speed, stress (or the linear-elastic update for solid tests).
+                          sound speed, stress of the gas points; the linear-elastic update of the
+                          elastic points (bodies, :mod:`blastfrac.mpm.bodies`).
+
+Each point has a material kind (``mat_kind``: gas or elastic) and its own Lamé constants, so the products
+and any number of elastic bodies share one grid, with one launch per stage.
 
 All arrays are allocated once in the constructor; a step allocates nothing.  2D plane
 strain: masses [kg/m], volumes [m^2/m = m^2], energies [J/m], forces [N/m].
@@ -25,7 +29,7 @@ import warp as wp
 from blastfrac._warp import resolve_device
 from blastfrac.materials.cj import cj_state
 from blastfrac.materials.jwl import JWLParams, jwl_sound_speed_sq_np
-from blastfrac.materials.linear_elastic_mp import LinearElasticMP, strain_energy_density_np, update_elastic_state
+from blastfrac.materials.linear_elastic_mp import LinearElasticMP, strain_energy_density_np
 from blastfrac.mpm.apic import (
     TRANSFERS,
     affine_angular_momentum_np,
@@ -33,6 +37,7 @@ from blastfrac.mpm.apic import (
     affine_inertia_np,
     affine_kinetic_energy_np,
 )
+from blastfrac.mpm.bodies import body_material, point_materials
 from blastfrac.mpm.burn import BURN_MODES
 from blastfrac.mpm.initiation import body_lighting_times
 from blastfrac.mpm.grid import BOX_STEPS, Grid, GridSpec
@@ -48,6 +53,7 @@ from blastfrac.mpm.kernels_grid import (
 )
 from blastfrac.mpm.kernels_misc import max_signal_speed
 from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
+from blastfrac.mpm.kernels_solid import update_elastic_state
 from blastfrac.mpm.seeding import charge_area_centroid, charge_bbox, seed_charges
 from blastfrac.mpm.shape import SHAPE_IDS, shape_1d_np
 
@@ -73,7 +79,12 @@ class MPMOptions:
 
 
 def grid_from_config(config) -> GridSpec:
-    """Grid covering ``grid.bounds`` or the charges' box plus margin (+2 stencil cells)."""
+    """Grid covering ``grid.bounds`` or the charges' box plus margin (+2 stencil cells).
+
+    The symmetry lines of a half or quarter model (the charges' ``cuts``, :mod:`blastfrac.mpm.seeding`) are box
+    edges whatever the bounds say there: on that axis the grid is shifted so that the line is a node line 2 cells
+    inside its edge, where :func:`boundary_walls` puts a slip wall (an exact plane of symmetry).
+    """
     g = config.grid
     if g.bounds is not None:
         lo, hi = np.asarray(g.bounds[0], float), np.asarray(g.bounds[1], float)
@@ -83,7 +94,24 @@ def grid_from_config(config) -> GridSpec:
         hi = np.max([b[1] for b in boxes], axis=0)
         margin = g.margin if g.margin is not None else float(np.max(hi - lo))
         lo, hi = lo - margin, hi + margin
-    return GridSpec.from_bounds(lo, hi, g.cell_size)
+    from blastfrac.mpm.seeding import symmetry_cuts
+
+    spec = GridSpec.from_bounds(lo, hi, g.cell_size)
+    cuts = symmetry_cuts(config.charges)
+    if not cuts:
+        return spec
+    h = g.cell_size
+    x0, n = [spec.x0, spec.y0], [spec.nx, spec.ny]
+    for c in cuts:
+        a = c.axis
+        if c.sign < 0:                                   # the line is the lower edge: x0 = line − 2h
+            top = x0[a] + (n[a] - 1) * h
+            x0[a] = c.coord - 2 * h
+            n[a] = max(int(np.ceil((top - x0[a]) / h - 1e-9)) + 1, 5)
+        else:                                            # the upper edge: the last node 2 cells beyond the line
+            n[a] = max(int(np.ceil((c.coord + 2 * h - x0[a]) / h - 1e-9)) + 1, 5)
+            x0[a] = c.coord + 2 * h - (n[a] - 1) * h
+    return GridSpec(x0[0], x0[1], h, n[0], n[1])
 
 
 def boundary_walls(config, spec: GridSpec) -> dict[str, tuple[float, str]]:
@@ -91,33 +119,61 @@ def boundary_walls(config, spec: GridSpec) -> dict[str, tuple[float, str]]:
 
     The wall is the box of :func:`grid_from_config` widened outwards to grid lines: the nodes 2 cells inside the
     grid's edges (``GridSpec.from_bounds`` pads 2 cells and aligns), which leaves two ghost-node rows behind it.
+    A symmetry line of a half or quarter model (the charges' ``cuts``) is a slip wall exactly on the line.
     """
+    from blastfrac.mpm.seeding import symmetry_cuts
+
     b = getattr(config.grid, "boundaries", None)
-    if b is None:
-        return {}
-    h = spec.h
-    xu, yu = spec.upper
-    pos = {"left": spec.x0 + 2 * h, "right": xu - 2 * h, "bottom": spec.y0 + 2 * h, "top": yu - 2 * h}
-    return {side: (pos[side], getattr(b, side)) for side in pos if getattr(b, side) != "open"}
+    walls = {}
+    if b is not None:
+        h = spec.h
+        xu, yu = spec.upper
+        pos = {"left": spec.x0 + 2 * h, "right": xu - 2 * h, "bottom": spec.y0 + 2 * h, "top": yu - 2 * h}
+        walls = {side: (pos[side], getattr(b, side)) for side in pos if getattr(b, side) != "open"}
+    for c in symmetry_cuts(getattr(config, "charges", None) or []):
+        walls[c.side] = (c.coord, "slip")
+    return walls
+
+
+def _grid_covering_bodies(config):
+    """``config`` itself, or with no ``grid.bounds`` and elastic bodies a copy whose bounds are the box of the
+    charges and bodies plus ``grid.margin`` (default: the box's larger side), the rule of :func:`grid_from_config`
+    extended to the bodies."""
+    bodies = getattr(config, "bodies", None) or []
+    if config.grid.bounds is not None or not bodies:
+        return config
+    boxes = [charge_bbox(c) for c in [*config.charges, *bodies]]
+    lo = np.min([b[0] for b in boxes], axis=0)
+    hi = np.max([b[1] for b in boxes], axis=0)
+    margin = config.grid.margin if config.grid.margin is not None else float(np.max(hi - lo))
+    bounds = (tuple(map(float, lo - margin)), tuple(map(float, hi + margin)))
+    return config.model_copy(update={"grid": config.grid.model_copy(update={"bounds": bounds})})
 
 
 class MPMSolver:
-    """Explicit MUSL MPM for JWL detonation products (or a linear-elastic solid, for tests).
+    """Explicit MUSL MPM for JWL detonation products and linear-elastic bodies (or a linear-elastic solid alone,
+    the MPM core benchmarks).
 
     Particle arrays (shape [n]): x, v, v_pic [m/s], f_ext_p [N/m] (vec2d); f_ext_moment [N] (mat22d: first
     moment Σ f ⊗ (x_f − x_p) of external forces applied off the particle centre, see ``p2g``); b_aff [m^2/s]
     (mat22d: the APIC affine moment B_p, C_p = B_p D_p⁻¹, :mod:`blastfrac.mpm.apic`; stays 0 with FLIP/PIC); mass [kg/m];
     vol, vol0, vol_prev [m^2]; rho [kg/m^3]; ie [J/m] (JWL internal energy; elastic solid: the work
-    done on it); p, q [Pa]; burn [-]; light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32).
+    done on it); p, q [Pa]; burn [-]; light_time [s]; cs [m/s]; stress, grad_v (mat22d) [Pa], [1/s]; active (int32);
+    mat_kind (int32: gas or elastic, :mod:`blastfrac.mpm.bodies`); lam, mu [Pa] (the elastic points' Lamé constants,
+    0 for gas). Host: body_id [n] (the body of each point, −1 for gas), charge_id [n] (the charge, −1 for bodies),
+    bodies (one LinearElasticMP per body), point_materials (:class:`blastfrac.mpm.bodies.PointMaterials`).
     Grid arrays: ``self.grid`` (:class:`Grid`).
     """
 
     # ------------------------------------------------------------------ construction
     def __init__(self, config, device: str = "cpu", particle_filter=None):
-        """Seed the charges of ``config`` (an ExplosiveConfig); ``particle_filter(x, vol) -> (x, vol[, keep])``, if
-        given, edits the seeded points before lighting times are computed (e.g. to clear them from the rock);
-        ``keep`` (a mask of the seeded points) keeps each point's charge, which the lighting times need."""
-        params: JWLParams = config.jwl()
+        """Seed the charges and elastic bodies of ``config`` (an ExplosiveConfig); ``particle_filter(x, vol) -> (x,
+        vol[, keep])``, if given, edits the seeded points before lighting times are computed (e.g. to clear them from
+        the rock); ``keep`` (a mask of the seeded points) keeps each point's charge or body, which the lighting times
+        and the body materials need. It is called once for the charges' points and once for each body's. Without
+        charges there is no JWL (``is_jwl`` False, ``p_cj`` None)."""
+        params: JWLParams | None = config.jwl()
+        bodies = list(getattr(config, "bodies", None) or [])
         opts = MPMOptions(
             shape=config.shape,
             ppc=config.grid.points_per_cell,
@@ -132,23 +188,40 @@ class MPMSolver:
             burn_width=config.burn.width_factor,
             p_cj=config.burn.p_cj,
         )
-        spec = grid_from_config(config)
-        x, vol, cid = seed_charges(config.charges, spec, opts.ppc, mode=config.seeding)
-        if particle_filter is not None:
-            res = particle_filter(x, vol)
-            x, vol = res[0], res[1]
-            if len(res) > 2:
-                cid = cid[res[2]]
-        if config.detonation_points or config.detonation_lines:
-            pts = np.array([d.position for d in config.detonation_points], float).reshape(-1, 2)
-            delays = np.array([d.delay for d in config.detonation_points], float)
-        else:                                   # each charge at its own centroid
-            pts = np.array([charge_area_centroid(c)[1] for c in config.charges])
-            delays = np.zeros(len(pts))
-        t_l = body_lighting_times(x, vol, cid, config.charges, pts, delays, config.detonation_lines, params.D)
-        self.charge_id = np.asarray(cid, np.int32)      # charge of each particle (host) [-]
+        spec = grid_from_config(_grid_covering_bodies(config))
+        # the bodies are seeded as further shapes after the charges (shape index >= number of charges)
+        x, vol, sid = seed_charges([*config.charges, *bodies], spec, opts.ppc, mode=config.seeding)
+        nc = len(config.charges)
+        if particle_filter is not None:         # the charges' points together (as without bodies), each body apart
+            parts = []
+            for sel in [sid < nc] + [sid == nc + k for k in range(len(bodies))]:
+                if sel.any():
+                    res = particle_filter(x[sel], vol[sel])
+                    parts.append((res[0], res[1], sid[sel][res[2]] if len(res) > 2 else sid[sel]))
+            if parts:
+                x, vol, sid = (np.concatenate([q[i] for q in parts]) for i in range(3))
+        body_id = np.where(sid >= nc, sid - nc, -1).astype(np.int32)
+        cid = np.where(sid < nc, sid, -1)
+        gas = body_id < 0
+        t_l = np.full(len(x), np.inf)                   # bodies never light
+        if nc:
+            if config.detonation_points or config.detonation_lines:
+                pts = np.array([d.position for d in config.detonation_points], float).reshape(-1, 2)
+                delays = np.array([d.delay for d in config.detonation_points], float)
+            else:                                   # each charge at its own centroid
+                pts = np.array([charge_area_centroid(c)[1] for c in config.charges])
+                delays = np.zeros(len(pts))
+            t_l[gas] = body_lighting_times(x[gas], vol[gas], cid[gas], config.charges, pts, delays,
+                                           config.detonation_lines, params.D)
+        self.charge_id = np.asarray(cid, np.int32)      # charge of each particle (host) [-], -1 for bodies
         self.config = config
-        self._build(x, vol, spec, params, opts, device, light_time=t_l)
+        v0 = None
+        if bodies:
+            v0 = np.zeros((len(x), 2))
+            for k, b in enumerate(bodies):
+                v0[body_id == k] = b.velocity
+        self._build(x, vol, spec, params, opts, device, v=v0, light_time=t_l, body_id=body_id,
+                    bodies=[body_material(b) for b in bodies])
         for k, ch in enumerate(config.charges):        # gas regions: burnt products in a given state
             st = getattr(ch, "gas_state", None)
             if st is not None:
@@ -168,21 +241,30 @@ class MPMSolver:
         x: np.ndarray,
         vol: np.ndarray,
         grid: GridSpec,
-        material: JWLParams | LinearElasticMP,
+        material: JWLParams | LinearElasticMP | None,
         options: MPMOptions | None = None,
         device: str = "cpu",
         v: np.ndarray | None = None,
         light_time: np.ndarray | None = None,
         burn: np.ndarray | None = None,
+        body_id: np.ndarray | None = None,
+        bodies=(),
     ) -> MPMSolver:
-        """Build from host arrays: x [n,2] m, vol [n] m^2, optional v [n,2] m/s, light_time [n] s, burn [n]."""
+        """Build from host arrays: x [n,2] m, vol [n] m^2, optional v [n,2] m/s, light_time [n] s, burn [n].
+
+        ``material``: the products' JWL set (None: elastic bodies only) or one LinearElasticMP for all points (the
+        MPM core benchmarks). ``body_id`` [n] (−1: gas) and ``bodies`` (LinearElasticMP list) make points elastic.
+        """
         self = cls.__new__(cls)
         self.config = None
         self.walls = {}
-        self._build(x, vol, grid, material, options or MPMOptions(), device, v=v, light_time=light_time, burn=burn)
+        self.charge_id = np.where(np.asarray(body_id) >= 0, -1, 0).astype(np.int32) if body_id is not None else None
+        self._build(x, vol, grid, material, options or MPMOptions(), device, v=v, light_time=light_time, burn=burn,
+                    body_id=body_id, bodies=bodies)
         return self
 
-    def _build(self, x, vol, spec: GridSpec, material, opts: MPMOptions, device, v=None, light_time=None, burn=None):
+    def _build(self, x, vol, spec: GridSpec, material, opts: MPMOptions, device, v=None, light_time=None, burn=None,
+               body_id=None, bodies=()):
         self.device = resolve_device(device)
         self.spec, self.material, self.opts = spec, material, opts
         self.is_jwl = isinstance(material, JWLParams)
@@ -190,7 +272,19 @@ class MPMSolver:
         vol = np.ascontiguousarray(vol, dtype=F64).reshape(-1)
         n = len(x)
         self.n = n
-        rho0 = material.rho0
+        self.elastic_only = isinstance(material, LinearElasticMP)   # one elastic material for all points
+        if self.elastic_only:
+            bodies, body_id = [material], np.zeros(n, np.int32)
+        self.bodies = list(bodies)
+        self.body_id = np.full(n, -1, np.int32) if body_id is None else np.asarray(body_id, np.int32).reshape(-1)
+        gas = self.body_id < 0
+        self.n_solid = int((~gas).sum())                 # elastic points [-]
+        if not self.is_jwl and gas.any():
+            raise ValueError("gas points (body_id < 0) need a JWL material")
+        pm = point_materials(self.body_id, self.bodies, material.rho0 if self.is_jwl else None)
+        self.point_materials = pm
+        # reference density of the mass cut-off: the explosive's, else the lightest body's
+        rho0 = material.rho0 if material is not None else min(b.rho0 for b in self.bodies)
         self.shape_kind = SHAPE_IDS[opts.shape]
         if opts.transfer not in TRANSFERS:
             raise ValueError(f"unknown velocity transfer '{opts.transfer}' (one of {', '.join(TRANSFERS)})")
@@ -207,14 +301,23 @@ class MPMSolver:
         self.v_pic, self.f_ext_p = z(wp.vec2d), z(wp.vec2d)
         self.f_ext_moment = z(wp.mat22d)
         self.b_aff = z(wp.mat22d)
-        self.mass = wp.array(rho0 * vol, dtype=wp.float64, device=d)
-        self.mass0_total = float(np.sum(rho0 * vol))       # the charges' mass at seeding [kg/m]
+        mass = pm.rho0 * vol
+        self.mass = wp.array(mass, dtype=wp.float64, device=d)
+        # the charges' mass at seeding [kg/m] (all points for an elastic-only solver)
+        self.mass0_total = float(np.sum(mass if self.elastic_only or self.n_solid == 0 else mass[gas]))
+        sv = self.v.numpy()[~gas]
+        self.body_energy0 = 0.5 * float((mass[~gas] * (sv * sv).sum(axis=1)).sum())   # bodies' KE at seeding [J/m]
         self.vol = wp.array(vol, dtype=wp.float64, device=d)
         self.vol0 = wp.array(vol, dtype=wp.float64, device=d)
         self.vol_prev = wp.array(vol, dtype=wp.float64, device=d)
-        self.rho = wp.array(np.full(n, rho0), dtype=wp.float64, device=d)
+        self.rho = wp.array(pm.rho0.copy(), dtype=wp.float64, device=d)
+        self.mat_kind = wp.array(pm.kind, dtype=wp.int32, device=d)
+        self.lam = wp.array(pm.lam, dtype=wp.float64, device=d)
+        self.mu = wp.array(pm.mu, dtype=wp.float64, device=d)
         self.ie, self.p, self.q, self.cs = z(wp.float64), z(wp.float64), z(wp.float64), z(wp.float64)
-        self.burn = wp.array(np.zeros(n) if burn is None else np.asarray(burn, F64), dtype=wp.float64, device=d)
+        if burn is not None:                 # elastic points never burn
+            burn = np.where(gas, np.asarray(burn, F64), 0.0)
+        self.burn = wp.array(np.zeros(n) if burn is None else burn, dtype=wp.float64, device=d)
         lt = np.zeros(n) if light_time is None else np.asarray(light_time, F64)
         self.light_time = wp.array(lt, dtype=wp.float64, device=d)
         self.stress, self.grad_v = z(wp.mat22d), z(wp.mat22d)
@@ -226,19 +329,24 @@ class MPMSolver:
             P = material
             self.p_cj = opts.p_cj if opts.p_cj is not None else cj_state(P).p
             self.burn_mode = BURN_MODES[opts.burn_mode]
-            self.ie.assign(P.E0 * vol)
+            chem = np.where(gas, P.E0 * vol, 0.0)
+            self.ie.assign(chem)
             c0 = np.sqrt(jwl_sound_speed_sq_np(1.0, P.E0, 0.0, P.rho0, P.A, P.B, P.R1, P.R2, P.omega))
-            self.cs.assign(np.full(n, max(float(c0), P.D)))
+            self.cs.assign(np.where(gas, max(float(c0), P.D), pm.cs0))
             if burn is not None:  # products already (partly) burnt: pressure and stress consistent with F
                 from blastfrac.materials.jwl import jwl_pressure_np
 
                 p0 = np.asarray(burn, F64) * jwl_pressure_np(1.0, P.E0, P.A, P.B, P.R1, P.R2, P.omega)
                 self.p.assign(p0)
                 self.stress.assign(-p0[:, None, None] * np.eye(2)[None])
-            self._chem0 = P.E0 * vol
-            self.chem0 = P.E0 * vol          # E0·V0 of each particle at seeding [J/m] (analysis.energy)
-        else:
-            self.cs.assign(np.full(n, material.p_wave_speed))
+            self._chem0 = chem
+            self.chem0 = chem.copy()         # E0·V0 of each particle at seeding [J/m] (0 for bodies; analysis.energy)
+        else:                                # elastic points only
+            self.p_cj = None
+            self.burn_mode = BURN_MODES[opts.burn_mode]
+            self._chem0 = np.zeros(n)
+            self.chem0 = np.zeros(n)
+            self.cs.assign(pm.cs0)
         self._check_in_grid(x)
         self._init_active_box()
         self._geo = (
@@ -262,14 +370,18 @@ class MPMSolver:
         m_p = rho V_p, the reference volume V_p0 = m_p / rho0 (so that V = rho0/rho and the JWL sound
         speed are those of the given density), ie = E V_p0 with p = a(V) + (omega/V) E, F = 1, sigma = -p I,
         c from the JWL and an infinite lighting time.  ``energies()['initial_internal']`` and ``chem0`` (the
-        energy the budget counts as supplied) become this state's internal energy.
+        energy the budget counts as supplied) become this state's internal energy. Elastic points (bodies) are
+        never changed.
         """
+        if self.n_solid and self.is_jwl:
+            sel = self.body_id < 0 if mask is None else np.asarray(mask, bool) & (self.body_id < 0)
+            mask = sel
         if mask is not None:
             sel = np.asarray(mask, bool)
             keep = {k: getattr(self, k).numpy().copy() for k in ("mass", "vol0", "vol_prev", "rho", "ie", "p", "q",
                                                                  "burn", "stress", "cs", "b_aff", "v", "light_time")}
             chem_keep, chem0_keep = self._chem0.copy(), self.chem0.copy()
-            self.set_gas_state(rho, p, v)
+            self._set_all_gas_state(rho, p, v)
             for k, old in keep.items():
                 new = getattr(self, k).numpy().copy()
                 new[~sel] = old[~sel]
@@ -277,6 +389,10 @@ class MPMSolver:
             self._chem0 = np.where(sel, self._chem0, chem_keep)
             self.chem0 = np.where(sel, self.chem0, chem0_keep)
             return
+        self._set_all_gas_state(rho, p, v)
+
+    def _set_all_gas_state(self, rho, p, v=None) -> None:
+        """:meth:`set_gas_state` on every point."""
         if not self.is_jwl:
             raise TypeError("set_gas_state needs a JWL material")
         from blastfrac.materials.jwl import V_FLOOR, jwl_a_np
@@ -413,23 +529,25 @@ class MPMSolver:
             g.renew_box()
 
     def update_eos(self, dt: float, t: float) -> None:
-        """Burn fraction at t + dt, then the material update (JWL products or elastic solid)."""
+        """The elastic points' stress update, then the gas points' burn fraction at t + dt and JWL update (each
+        kernel skips the points of the other kind)."""
         d = self.device
-        if not self.is_jwl:
-            m = self.material
+        if self.n_solid:
             wp.launch(
                 update_elastic_state,
                 dim=self.n,
-                inputs=[self.active, self.grad_v, self.rho, self.vol_prev, self.vol, F64(dt), F64(m.lam), F64(m.mu)],
+                inputs=[self.active, self.mat_kind, self.grad_v, self.rho, self.vol_prev, self.vol, self.lam, self.mu,
+                        F64(dt)],
                 outputs=[self.stress, self.p, self.cs, self.ie],
                 device=d,
             )
+        if not self.is_jwl:
             return
         P, o = self.material, self.opts
         wp.launch(
             update_burn,
             dim=self.n,
-            inputs=[self.active, self.light_time, self.vol, self.vol0, F64(t + dt), F64(P.D), F64(P.rho0), F64(self.p_cj),
+            inputs=[self.active, self.mat_kind, self.light_time, self.vol, self.vol0, F64(t + dt), F64(P.D), F64(P.rho0), F64(self.p_cj),
                     F64(o.burn_width), self.burn_mode],
             outputs=[self.burn],
             device=d,
@@ -437,7 +555,8 @@ class MPMSolver:
         wp.launch(
             update_jwl_state,
             dim=self.n,
-            inputs=[self.active, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v, self.burn, F64(P.rho0), F64(P.D),
+            inputs=[self.active, self.mat_kind, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v, self.burn,
+                    F64(P.rho0), F64(P.D),
                     F64(P.A), F64(P.B), F64(P.R1), F64(P.R2), F64(P.omega), F64(o.q1), F64(o.q2), F64(o.v_max)],
             outputs=[self.ie, self.p, self.q, self.cs, self.stress],
             device=d,
@@ -503,48 +622,70 @@ class MPMSolver:
         ``kinetic`` is Σ ½ m v², plus with APIC the affine part Σ ½ m tr(B D⁻¹ Bᵀ) (also given alone as
         ``kinetic_affine``; 0 with FLIP/PIC), the kinetic energy of the particles' linear velocity fields.
 
-        JWL: internal (sum ie), kinetic, total (internal + kinetic), released_chemical
-        (sum F E0 V0: chemical energy liberated by the burn), initial_internal (sum E0 V0)
+        Gas (JWL; over the gas points only, all 0 without charges): internal (sum ie), kinetic, total (internal +
+        kinetic), released_chemical (sum F E0 V0: chemical energy liberated by the burn), initial_internal (sum E0 V0)
         and gas_work (initial_internal - internal: work done by the products so far).
-        Elastic: kinetic, strain (the work done on the particles, kept in ``ie``: the stored
-        energy of the hypoelastic law), total (kinetic + strain) and strain_closed_form
+        Elastic bodies (only when there are some): body_kinetic (with its affine part body_kinetic_affine),
+        body_strain (the work done on them, kept in ``ie``) and body_strain_closed_form (sum 1/2 sigma : C^-1 :
+        sigma V), as for an elastic-only solver below.
+        Elastic-only solver (one LinearElasticMP for all points): kinetic, strain (the work done on the particles,
+        kept in ``ie``: the stored energy of the hypoelastic law), total (kinetic + strain) and strain_closed_form
         (sum 1/2 sigma : C^-1 : sigma V, equal to strain at small strain; see
         :mod:`blastfrac.materials.linear_elastic_mp`).
         """
         a = self._act()
-        v = self.v.numpy()[a]
-        ke = 0.5 * float((self.mass.numpy()[a] * (v * v).sum(axis=1)).sum())
+        if self.elastic_only:
+            ke, ke_aff, se, cf = self._kinetic_strain(a)
+            return {"kinetic": ke, "kinetic_affine": ke_aff, "strain": se, "total": ke + se, "strain_closed_form": cf}
+        g = a if self.n_solid == 0 else a & (self.body_id < 0)
+        v = self.v.numpy()[g]
+        ke = 0.5 * float((self.mass.numpy()[g] * (v * v).sum(axis=1)).sum())
         ke_aff = 0.0
         if self.apic:
-            B, D = self.b_aff.numpy()[a], self.affine_inertia()[a]
-            ke_aff = float(affine_kinetic_energy_np(self.mass.numpy()[a], B, D).sum())
+            B, D = self.b_aff.numpy()[g], self.affine_inertia()[g]
+            ke_aff = float(affine_kinetic_energy_np(self.mass.numpy()[g], B, D).sum())
             ke += ke_aff
-        if not self.is_jwl:
-            m = self.material
-            w = strain_energy_density_np(self.stress.numpy()[a], m.E, m.nu)
-            se = float(self.ie.numpy()[a].sum())
-            return {"kinetic": ke, "kinetic_affine": ke_aff, "strain": se, "total": ke + se,
-                    "strain_closed_form": float((w * self.vol.numpy()[a]).sum())}
-        ie = float(self.ie.numpy()[a].sum())
-        chem0 = self._chem0[a]
-        return {
+        ie = float(self.ie.numpy()[g].sum())
+        chem0 = self._chem0[g]
+        out = {
             "internal": ie,
             "kinetic": ke,
             "kinetic_affine": ke_aff,
             "total": ie + ke,
-            "released_chemical": float((self.burn.numpy()[a] * chem0).sum()),
+            "released_chemical": float((self.burn.numpy()[g] * chem0).sum()),
             "initial_internal": float(chem0.sum()),
             "gas_work": float(chem0.sum() - ie),
         }
+        if self.n_solid:
+            bke, bke_aff, bse, bcf = self._kinetic_strain(a & (self.body_id >= 0))
+            out.update({"body_kinetic": bke, "body_kinetic_affine": bke_aff, "body_strain": bse,
+                        "body_strain_closed_form": bcf})
+        return out
+
+    def _kinetic_strain(self, sel: np.ndarray) -> tuple[float, float, float, float]:
+        """(kinetic incl. affine, affine kinetic, stress work Σ ie, closed-form strain energy) of the elastic points
+        ``sel`` [J/m]."""
+        v = self.v.numpy()[sel]
+        m = self.mass.numpy()[sel]
+        ke = 0.5 * float((m * (v * v).sum(axis=1)).sum())
+        ke_aff = 0.0
+        if self.apic:
+            ke_aff = float(affine_kinetic_energy_np(m, self.b_aff.numpy()[sel], self.affine_inertia()[sel]).sum())
+            ke += ke_aff
+        pm = self.point_materials
+        w = strain_energy_density_np(self.stress.numpy()[sel], pm.E[sel], pm.nu[sel])
+        return ke, ke_aff, float(self.ie.numpy()[sel].sum()), float((w * self.vol.numpy()[sel]).sum())
 
     def particle_fields(self) -> dict[str, np.ndarray]:
         """Host copies of the active particles' fields for output (SI units).
 
         position [n,2] m, velocity [n,2] m/s, pressure [n] Pa, density [n] kg/m^3,
-        burn_fraction [n], relative_volume [n], internal_energy [n] J/m, volume [n] m^2.
+        burn_fraction [n], relative_volume [n], internal_energy [n] J/m (elastic points: the work done on
+        them), volume [n] m^2, body [n] (the elastic body of each point, -1 for gas).
         """
         a = self._act()
         return {
+            "body": self.body_id[a].copy(),
             "position": self.x.numpy()[a].copy(),
             "velocity": self.v.numpy()[a].copy(),
             "pressure": self.p.numpy()[a].copy(),
@@ -584,8 +725,11 @@ class MPMSolver:
         self.light_time.assign(np.asarray(t_light, F64))
 
     def cj_check(self) -> dict:
-        """The CJ consistency report of the JWL set (see :func:`blastfrac.explosives.library.cj_report`)."""
+        """The CJ consistency report of the JWL set (see :func:`blastfrac.explosives.library.cj_report`); None
+        without one (elastic bodies only)."""
         from blastfrac.explosives.library import cj_report
 
+        if not self.is_jwl:
+            return None
         name = self.config.name if self.config is not None and self.config.name else "custom"
         return cj_report(self.material, name)

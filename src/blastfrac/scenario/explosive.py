@@ -1,7 +1,8 @@
-"""Scenario section ``[explosive]``: the MPM detonation-products model (pydantic v2).
+"""Scenario section ``[explosive]``: the MPM detonation-products model and elastic MPM bodies (pydantic v2).
 
 SI units throughout.  The explosive is either a library name (``name``) or a full
-custom JWL set (``constants``), never both.  Example::
+custom JWL set (``constants``), never both; a run without charges (elastic bodies only, an
+impactor) needs neither.  Example::
 
     [explosive]
     name = "emulsion"
@@ -11,6 +12,15 @@ custom JWL set (``constants``), never both.  Example::
     [explosive.grid]
     cell_size = 0.002
     margin = 0.06
+
+    [[explosive.bodies]]          # an elastic body on the same grid (mpm/bodies.py)
+    kind = "circle"
+    center = [0.1, 0.0]
+    radius = 0.01
+    density = 7800.0
+    youngs_modulus = 200e9
+    poisson_ratio = 0.3
+    velocity = [-50.0, 0.0]
 """
 
 from __future__ import annotations
@@ -56,13 +66,12 @@ _GAS_STATE_DOC = ("burnt products in this state from t = 0 instead of an explosi
                   "(explosive_released)")
 
 
-class CircleCharge(_Model):
-    """A circular charge (a borehole section in plane strain)."""
+class _CircleShape(_Model):
+    """A circle: the shape of a charge or a body."""
 
-    kind: Literal["circle"] = Field(description="charge shape tag")
+    kind: Literal["circle"] = Field(description="shape tag")
     center: Point = Field(description="centre (x, y) [m]")
     radius: float = Field(gt=0, description="radius [m]")
-    gas_state: GasState | None = Field(default=None, description=_GAS_STATE_DOC)
 
     @property
     def area(self) -> float:
@@ -82,15 +91,14 @@ class CircleCharge(_Model):
         return geo.seg_dist(self.center, a, b) <= self.radius * (1 + tol)
 
 
-class PolygonCharge(_Model):
-    """A polygonal charge; vertices in order (either orientation)."""
+class _PolygonShape(_Model):
+    """A simple polygon, vertices in order (either orientation): the shape of a charge or a body."""
 
-    kind: Literal["polygon"] = Field(description="charge shape tag")
+    kind: Literal["polygon"] = Field(description="shape tag")
     vertices: list[Point] = Field(min_length=3, description="vertices (x, y) [m], at least 3")
-    gas_state: GasState | None = Field(default=None, description=_GAS_STATE_DOC)
 
     @model_validator(mode="after")
-    def _simple(self) -> PolygonCharge:
+    def _simple(self) -> _PolygonShape:
         v = self.vertices
         rep = geo.repeated_vertex(v)
         if rep is not None:
@@ -124,7 +132,60 @@ class PolygonCharge(_Model):
         return any(geo.segments_touch(a, b, v[i], v[(i + 1) % len(v)]) for i in range(len(v)))
 
 
+class CircleCharge(_CircleShape):
+    """A circular charge (a borehole section in plane strain)."""
+
+    gas_state: GasState | None = Field(default=None, description=_GAS_STATE_DOC)
+
+
+class PolygonCharge(_PolygonShape):
+    """A polygonal charge; vertices in order (either orientation)."""
+
+    gas_state: GasState | None = Field(default=None, description=_GAS_STATE_DOC)
+
+
 Charge = Annotated[CircleCharge | PolygonCharge, Field(discriminator="kind")]
+
+
+class _ElasticBodyMaterial(_Model):
+    """The material and initial velocity of an elastic MPM body (mpm/bodies.py)."""
+
+    density: float = Field(gt=0, le=1e5, description="mass density [kg/m^3], at most 1e5")
+    youngs_modulus: float = Field(gt=0, le=1e13, description="Young's modulus [Pa], at most 1e13")
+    poisson_ratio: float = Field(ge=0, lt=0.5, description="Poisson's ratio [-], in [0, 0.5)")
+    velocity: Point = Field(default=(0.0, 0.0), description="initial velocity (vx, vy) [m/s] of the whole body")
+    name: str | None = Field(default=None, pattern=r"^[A-Za-z0-9_\-]+$",
+                             description="label of the body in summary.json (letters, digits, _ and -); default body<k>")
+
+    @property
+    def p_wave_speed(self) -> float:
+        """Plane-strain P-wave speed sqrt((λ + 2μ)/ρ) [m/s]."""
+        e, nu = self.youngs_modulus, self.poisson_ratio
+        return math.sqrt(e * (1 - nu) / ((1 + nu) * (1 - 2 * nu)) / self.density)
+
+
+class CircleBody(_ElasticBodyMaterial, _CircleShape):
+    """A circular elastic body (a disk; a rod in plane strain)."""
+
+
+class PolygonBody(_ElasticBodyMaterial, _PolygonShape):
+    """A polygonal elastic body (a slab, a plate); vertices in order (either orientation)."""
+
+
+Body = Annotated[CircleBody | PolygonBody, Field(discriminator="kind")]
+
+
+def shapes_overlap(a, b, tol: float = 1e-9) -> bool:
+    """True when two charge/body shapes share area (touching along a boundary is allowed); tol relative to the
+    shapes' size."""
+    scale = max(max(q - p for p, q in zip(*sh.bbox)) for sh in (a, b))
+    t = tol * scale
+    if a.kind == "circle" and b.kind == "circle":
+        return math.dist(a.center, b.center) < a.radius + b.radius - t
+    if a.kind == "polygon" and b.kind == "polygon":
+        return geo.polygons_overlap(a.vertices, b.vertices, t)
+    c, q = (a, b) if a.kind == "circle" else (b, a)
+    return geo.point_in_polygon(c.center, q.vertices) or geo.polygon_dist(c.center, q.vertices) < c.radius - t
 
 
 class DetonationPoint(_Model):
@@ -171,15 +232,17 @@ class GridConfig(_Model):
 
     cell_size: float = Field(gt=0, description="grid cell size h [m]")
     bounds: tuple[Point, Point] | None = Field(
-        default=None, description="grid box ((xmin, ymin), (xmax, ymax)) [m]; default: charges' box plus margin"
+        default=None, description="grid box ((xmin, ymin), (xmax, ymax)) [m]; default: the box of the charges (and "
+        "bodies) plus margin; required without charges"
     )
     margin: float | None = Field(
-        default=None, ge=0, description="clearance added around the charges' box [m]; default: the box's larger side"
+        default=None, ge=0, description="clearance added around the charges' (and bodies') box [m]; default: the box's "
+        "larger side"
     )
     points_per_cell: int = Field(default=2, ge=1, le=6, description="material points per cell per direction [-]")
     boundaries: GridBoundaries = Field(
         default_factory=GridBoundaries, description="side conditions of the grid box (left, right, bottom, top: "
-        "'open', 'fixed' or 'slip'); a wall lies on the box (bounds, or the charges' box plus margin) widened outwards "
+        "'open', 'fixed' or 'slip'); a wall lies on the box (bounds, or the charges' and bodies' box plus margin) widened outwards "
         "to the nearest grid lines (multiples of cell_size); default: all open"
     )
 
@@ -207,11 +270,20 @@ class BurnConfig(_Model):
 
 
 class ExplosiveConfig(_Model):
-    """MPM explosive section: JWL set, charges, initiation, grid and numerical options."""
+    """MPM explosive section: JWL set, charges, elastic bodies, initiation, grid and numerical options."""
 
-    name: str | None = Field(default=None, description="library explosive: emulsion, petn, tnt, anfo")
+    name: str | None = Field(default=None, description="library explosive: emulsion, petn, tnt, anfo; needed "
+                             "with charges (or constants), not for elastic bodies alone")
     constants: JWLConstants | None = Field(default=None, description="custom JWL set (instead of name)")
-    charges: list[Charge] = Field(min_length=1, description="charge regions filled with material points")
+    charges: list[Charge] = Field(
+        default_factory=list, description="charge regions filled with material points; at least one charge or body"
+    )
+    bodies: list[Body] = Field(
+        default_factory=list, description="elastic MPM bodies ([[explosive.bodies]]: an impactor, a flyer plate): "
+        "regions of material points with their own density, Young's modulus, Poisson's ratio and initial velocity "
+        "on the explosive's grid (no slip against the gas on the grid); they touch the rock through the particle-edge "
+        "contact; each lies in a borehole or outside the rock and overlaps no charge or other body (docs/explosive.md)"
+    )
     detonation_points: list[DetonationPoint] = Field(
         default_factory=list, description="initiation points; each lights the charge it lies in (and the charges "
         "touching it), never through rock; default: the centroid of each charge, no delay"
@@ -257,7 +329,11 @@ class ExplosiveConfig(_Model):
 
     @model_validator(mode="after")
     def _one_source(self) -> ExplosiveConfig:
-        if (self.name is None) == (self.constants is None):
+        if not self.charges and not self.bodies:
+            raise ValueError("charges: give at least one charge (or an elastic body in explosive.bodies)")
+        if self.name is not None and self.constants is not None:
+            raise ValueError("give exactly one of explosive.name (library) or explosive.constants (custom JWL set)")
+        if self.charges and self.name is None and self.constants is None:
             raise ValueError("give exactly one of explosive.name (library) or explosive.constants (custom JWL set)")
         if self.name is not None:
             from blastfrac.explosives.library import get_explosive
@@ -270,20 +346,34 @@ class ExplosiveConfig(_Model):
             for i in range(j):
                 if ch == self.charges[i]:
                     raise ValueError(f"charges[{j}]: repeats charges[{i}]")
+        shapes = [(f"charges[{i}]", ch) for i, ch in enumerate(self.charges)]
+        shapes += [(f"bodies[{i}]", b) for i, b in enumerate(self.bodies)]
         spacing = self.grid.cell_size / self.grid.points_per_cell
-        for i, ch in enumerate(self.charges):
+        for key, ch in shapes:
             if ch.area < spacing**2:
                 raise ValueError(f"grid.cell_size: the particle spacing cell_size/points_per_cell = {spacing:.4g} m leaves "
-                                 f"charges[{i}] (area {ch.area:.4g} m²) less than one material point; use a finer grid")
+                                 f"{key} (area {ch.area:.4g} m²) less than one material point; use a finer grid")
         if self.grid.bounds is not None:
             (x0, y0), (x1, y1) = self.grid.bounds
             tol = 1e-9 * max(x1 - x0, y1 - y0)
-            for i, ch in enumerate(self.charges):
+            for key, ch in shapes:
                 (a0, b0), (a1, b1) = ch.bbox
                 if a0 < x0 - tol or b0 < y0 - tol or a1 > x1 + tol or b1 > y1 + tol:
                     raise ValueError(f"grid.bounds: (({x0:.6g}, {y0:.6g}), ({x1:.6g}, {y1:.6g})) does not cover "
-                                     f"charges[{i}] (box ({a0:.6g}, {b0:.6g})–({a1:.6g}, {b1:.6g})); the grid must "
-                                     "cover every charge")
+                                     f"{key} (box ({a0:.6g}, {b0:.6g})–({a1:.6g}, {b1:.6g})); the grid must "
+                                     "cover every charge and body")
+        elif not self.charges:
+            raise ValueError("grid.bounds: needed without charges (elastic bodies only): give the grid box "
+                             "((xmin, ymin), (xmax, ymax)) [m] that covers the bodies and the rock they move to")
+        for j, b in enumerate(self.bodies):
+            for key, other in shapes[: len(self.charges) + j]:
+                if shapes_overlap(b, other):
+                    raise ValueError(f"bodies[{j}]: overlaps {key}; a body must not overlap a charge or another body")
+            if b.name is not None:
+                for i in range(j):
+                    if self.bodies[i].name == b.name:
+                        raise ValueError(f"bodies[{j}].name: '{b.name}' is already used by bodies[{i}]; names must "
+                                         "be unique")
         for k, dp in enumerate(self.detonation_points):
             if not any(ch.contains(dp.position) for ch in self.charges):
                 raise ValueError(f"detonation_points[{k}]: position ({dp.position[0]:.6g}, {dp.position[1]:.6g}) is "
@@ -301,13 +391,16 @@ class ExplosiveConfig(_Model):
         return self
 
     def jwl(self):
-        """The resolved :class:`blastfrac.materials.jwl.JWLParams`."""
+        """The resolved :class:`blastfrac.materials.jwl.JWLParams`; None without charges (elastic bodies only: no
+        JWL is used, even if one is named)."""
         from blastfrac.explosives.library import get_explosive
         from blastfrac.materials.jwl import JWLParams
 
+        if not self.charges:
+            return None
         if self.constants is not None:
             return JWLParams(**self.constants.model_dump())
         return get_explosive(self.name)
 
 
-__all__ = ["ExplosiveConfig", "JWLConstants", "CircleCharge", "PolygonCharge", "DetonationPoint", "DetonationLine", "GridConfig", "GridBoundaries", "BurnConfig"]
+__all__ = ["ExplosiveConfig", "JWLConstants", "CircleCharge", "PolygonCharge", "CircleBody", "PolygonBody", "DetonationPoint", "DetonationLine", "GridConfig", "GridBoundaries", "BurnConfig"]

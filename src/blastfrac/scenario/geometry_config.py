@@ -120,6 +120,9 @@ def _seg_dist(p: Point, a: Point, b: Point) -> float:
 
 Domain = Annotated[Union[RectangleDomain, DiscDomain, PolygonDomain], Field(discriminator="type")]
 
+#: the sides of a rectangle domain that geometry.symmetry may name
+SYMMETRY_SIDES = ("left", "right", "bottom", "top")
+
 
 class Borehole(_Strict):
     center: Point = Field((0.0, 0.0), description="Centre of the borehole [m].")
@@ -269,6 +272,13 @@ class GeometryConfig(_Strict):
         default_factory=list, description="`[[geometry.joints]]`: pre-existing joint sets (given segments or a "
         "generated network) embedded in the mesh, whose interfaces get joint properties (docs/joints.md).",
     )
+    symmetry: list[str] = Field(
+        default_factory=list, description="Sides of a rectangle domain that are symmetry lines, e.g. ['left', "
+        "'bottom'] (half and quarter models, docs/explosive.md 'Half and quarter models'): each side gets a roller "
+        "(boundaries.<side>, written to resolved.toml), a borehole centred on it or crossing it and its charge are cut "
+        "by it, and the MPM grid has a slip (image) wall exactly on it. At most one of left/right and one of "
+        "bottom/top; not with mesh_file.",
+    )
 
     @field_validator("mesh_file")
     @classmethod
@@ -281,10 +291,15 @@ class GeometryConfig(_Strict):
 
     @model_validator(mode="after")
     def _holes_inside(self) -> "GeometryConfig":
+        self._check_symmetry()
         for i, b in enumerate(self.boreholes):
-            if not self.domain.contains(b.center, margin=b.radius):
+            if self.symmetry:
+                self._check_cut_hole(i, b)
+            elif not self.domain.contains(b.center, margin=b.radius):
+                hint = (" (a rectangle's side may cut a borehole when it is a symmetry line, geometry.symmetry)"
+                        if isinstance(self.domain, RectangleDomain) else "")
                 raise ValueError(
-                    f"boreholes[{i}]: centre {b.center}, radius {b.radius} m: not fully inside the domain"
+                    f"boreholes[{i}]: centre {b.center}, radius {b.radius} m: not fully inside the domain{hint}"
                 )
         for i in range(len(self.boreholes)):
             for j in range(i + 1, len(self.boreholes)):
@@ -299,6 +314,62 @@ class GeometryConfig(_Strict):
 
             check_joint_config(self)
         return self
+
+    # ------------------------------------------------------------------ symmetry lines (half and quarter models)
+    def _check_symmetry(self) -> None:
+        if not self.symmetry:
+            return
+        sides = SYMMETRY_SIDES
+        for k, s in enumerate(self.symmetry):
+            if not isinstance(self.domain, RectangleDomain):
+                raise ValueError(f"symmetry: needs a rectangle domain (a symmetry line is a side of the rectangle); "
+                                 f"this domain is a {self.domain.type}")
+            if s not in sides:
+                raise ValueError(f"symmetry[{k}]: '{s}' is not a side of the rectangle; give some of "
+                                 f"{', '.join(repr(x) for x in sides)}")
+            if s in self.symmetry[:k]:
+                raise ValueError(f"symmetry[{k}]: '{s}' is listed twice; give each side once")
+        for a, b in (("left", "right"), ("bottom", "top")):
+            if a in self.symmetry and b in self.symmetry:
+                raise ValueError(f"symmetry: '{a}' and '{b}' are both symmetry lines; give at most one side per "
+                                 "direction (a strip between two parallel symmetry lines is not supported)")
+        if self.mesh_file is not None:
+            raise ValueError("symmetry: not available with mesh_file (the cut holes and side tags come from the "
+                             "mesher); give the sides a roller in [boundaries] and the grid a slip wall by hand")
+
+    def symmetry_lines(self) -> list[tuple[str, int, float, int]]:
+        """(side, axis, coordinate [m], sign) of each symmetry line x_axis = coordinate; the modelled part is where
+        sign·(x_axis − coordinate) ≤ 0 (sign −1 for 'left' and 'bottom', +1 for 'right' and 'top')."""
+        if not self.symmetry:
+            return []
+        (x0, y0), (x1, y1) = self.domain.bbox
+        line = {"left": (0, x0, -1), "right": (0, x1, 1), "bottom": (1, y0, -1), "top": (1, y1, 1)}
+        return [(s, *line[s]) for s in self.symmetry]
+
+    def cut_sides(self, i: int) -> list[str]:
+        """The symmetry sides that cut borehole i (its circle crosses them or its centre lies on them)."""
+        b = self.boreholes[i]
+        tol = 1e-9 * b.radius
+        return [s for s, axis, c, sign in self.symmetry_lines() if sign * (c - b.center[axis]) < b.radius - tol]
+
+    def _check_cut_hole(self, i: int, b: "Borehole") -> None:
+        """A hole inside the rectangle, or cut only by symmetry sides with its centre on the modelled side."""
+        (x0, y0), (x1, y1) = self.domain.bbox
+        tol = 1e-9 * b.radius
+        inward = {"left": b.center[0] - x0, "right": x1 - b.center[0], "bottom": b.center[1] - y0,
+                  "top": y1 - b.center[1]}
+        for side in SYMMETRY_SIDES:
+            d = inward[side]
+            if d >= b.radius - tol:
+                continue
+            if side not in self.symmetry:
+                raise ValueError(f"boreholes[{i}]: centre {b.center}, radius {b.radius} m: not fully inside the "
+                                 f"domain: it crosses the {side} side, which is not a symmetry line (geometry."
+                                 f"symmetry = {self.symmetry}); only a symmetry line may cut a borehole")
+            if d < -tol:
+                raise ValueError(f"boreholes[{i}]: centre {b.center} lies beyond the symmetry line on the {side} "
+                                 "side, outside the modelled part; put the centre on the line (a hole cut by it) or "
+                                 "inside the domain")
 
     def joint_mesh_size(self, i: int) -> float:
         """Element size along joint set i [m] (its mesh_size, default geometry.mesh_size)."""

@@ -468,6 +468,7 @@ class Scenario(_Strict):
         for name in self.boundaries:
             if name not in sides:
                 raise ValueError(f"boundaries.{name}: unknown side; this domain has {sorted(sides)}")
+        _apply_symmetry(self)
         loaded: dict[int, int] = {}
         for i, bp in enumerate(self.borehole_pressure):
             if bp.borehole >= len(self.geometry.boreholes):
@@ -503,6 +504,73 @@ class Scenario(_Strict):
         return self.boundaries.get(side, BoundarySide())
 
 
+def _apply_symmetry(sc: "Scenario") -> None:
+    """geometry.symmetry (half and quarter models, docs/explosive.md): a roller on each symmetry side and a slip wall
+    on the MPM grid's side of the same name, both written to resolved.toml; initiators and charges on the modelled
+    side. An explicit conflicting condition is an error."""
+    lines = sc.geometry.symmetry_lines()
+    if not lines:
+        return
+    for side, *_ in lines:
+        b = sc.boundaries.get(side)
+        if b is not None and b.type != "roller":
+            raise ValueError(f"boundaries.{side}: type '{b.type}' on a symmetry line (geometry.symmetry); a symmetry "
+                             f"line is a roller (normal displacement 0, free to slide): remove boundaries.{side} or "
+                             "give type = 'roller'")
+        sc.boundaries[side] = BoundarySide(type="roller")
+    ex = sc.explosive
+    if ex is None:
+        return
+    gb = ex.grid.boundaries
+    for side, *_ in lines:
+        if side in gb.model_fields_set and getattr(gb, side) != "slip":
+            raise ValueError(f"explosive.grid.boundaries.{side}: '{getattr(gb, side)}' on a symmetry line (geometry."
+                             "symmetry); the MPM grid has a slip wall exactly on it (an exact plane of symmetry): "
+                             "remove it or give 'slip'")
+        setattr(gb, side, "slip")
+    (x0, y0), (x1, y1) = sc.geometry.domain.bbox
+    tol = 1e-9 * max(x1 - x0, y1 - y0)
+
+    def beyond(p) -> str | None:
+        for side, axis, c, sign in lines:
+            if sign * (p[axis] - c) > tol:
+                return f"beyond the symmetry line on the {side} side ({'xy'[axis]} = {c:.6g} m)"
+        return None
+
+    hint = ("outside the modelled part; a half or quarter model mirrors what lies on its side of the line, so give "
+            "the initiator there or on the line")
+    for k, dp in enumerate(ex.detonation_points):
+        if beyond(dp.position):
+            raise ValueError(f"explosive.detonation_points[{k}]: position {_fmt(dp.position)} lies "
+                             f"{beyond(dp.position)}, {hint}")
+    for k, dl in enumerate(ex.detonation_lines):
+        for end in ("start", "end"):
+            p = getattr(dl, end)
+            if beyond(p):
+                raise ValueError(f"explosive.detonation_lines[{k}].{end}: {_fmt(p)} lies {beyond(p)}, {hint}")
+    for i, ch in enumerate(ex.charges):
+        (a0, b0), (a1, b1) = _modelled_box(ch.bbox, sc.geometry)
+        if a1 - a0 <= tol or b1 - b0 <= tol:
+            raise ValueError(f"explosive.charges[{i}]: lies wholly beyond a symmetry line (geometry.symmetry = "
+                             f"{sc.geometry.symmetry}), outside the modelled part")
+    for i, b in enumerate(getattr(ex, "bodies", None) or []):
+        if _modelled_box(b.bbox, sc.geometry) != tuple(map(tuple, b.bbox)):
+            raise ValueError(f"explosive.bodies[{i}]: reaches across a symmetry line (geometry.symmetry); an elastic "
+                             "body cut by a symmetry line is not supported, keep it on the modelled side")
+
+
+def _modelled_box(box, geom: GeometryConfig) -> tuple[Point, Point]:
+    """A box ((x0, y0), (x1, y1)) clamped to the modelled side of geometry.symmetry's lines: the part of a charge
+    that a half or quarter model seeds."""
+    lo, hi = [float(v) for v in box[0]], [float(v) for v in box[1]]
+    for _, axis, c, sign in geom.symmetry_lines():
+        if sign < 0:
+            lo[axis] = max(lo[axis], c)
+        else:
+            hi[axis] = min(hi[axis], c)
+    return (lo[0], lo[1]), (hi[0], hi[1])
+
+
 def _unique_names(items, what: str) -> None:
     first: dict[str, int] = {}
     for j, it in enumerate(items):
@@ -516,13 +584,15 @@ def _fmt(p) -> str:
 
 
 def _explosive_fits_rock(ex: ExplosiveConfig, geom: GeometryConfig) -> None:
-    """Each charge lies inside a borehole or wholly outside the rock domain; the default grid covers it.
+    """Each charge and each elastic body lies inside a borehole or wholly outside the rock domain; the default grid
+    covers it.
 
-    Raises ValueError naming the first charge that breaks a rule (tolerance 1e-9 of the lengths involved).
+    Raises ValueError naming the first charge (or body) that breaks a rule (tolerance 1e-9 of the lengths involved).
     """
     d, holes = geom.domain, geom.boreholes
-    for i, ch in enumerate(ex.charges):
-        key = f"explosive.charges[{i}]"
+    shapes = [(f"explosive.charges[{i}]", ch, "charge") for i, ch in enumerate(ex.charges)]
+    shapes += [(f"explosive.bodies[{i}]", b, "body") for i, b in enumerate(ex.bodies)]
+    for key, ch, a in shapes:
         if ch.kind == "circle":
             c, r, pts = ch.center, ch.radius, None
             what = f"circle centre {_fmt(c)}, radius {r:.6g} m"
@@ -537,29 +607,29 @@ def _explosive_fits_rock(ex: ExplosiveConfig, geom: GeometryConfig) -> None:
             if pts is None:
                 if r > b.radius + tol:
                     raise ValueError(f"{key}: radius {r:.6g} m is larger than its borehole geometry.boreholes[{host}] "
-                                     f"(radius {b.radius:.6g} m); a charge must fit inside its hole")
+                                     f"(radius {b.radius:.6g} m); a {a} must fit inside its hole")
                 inside = math.dist(c, b.center) + r <= b.radius + tol
             else:
                 inside = all(math.dist(p, b.center) <= b.radius + tol for p in pts)
             if not inside:
                 raise ValueError(f"{key}: {what} extends past the wall of geometry.boreholes[{host}] (centre "
-                                 f"{_fmt(b.center)}, radius {b.radius:.6g} m) into the rock; a charge must lie "
+                                 f"{_fmt(b.center)}, radius {b.radius:.6g} m) into the rock; a {a} must lie "
                                  "inside its borehole or outside the rock")
         else:
             if d.contains(c):
-                raise ValueError(f"{key}: {what} lies in the rock (inside the domain and in no borehole); a charge "
+                raise ValueError(f"{key}: {what} lies in the rock (inside the domain and in no borehole); a {a} "
                                  "must lie inside a borehole or outside the rock")
             if _overlaps_domain(d, c, r, pts):
-                raise ValueError(f"{key}: {what} overlaps the rock across the domain boundary; a charge must lie "
+                raise ValueError(f"{key}: {what} overlaps the rock across the domain boundary; a {a} must lie "
                                  "inside a borehole or outside the rock")
     if ex.grid.bounds is None and ex.grid.margin is None:
         # the run's default grid covers the rock's box (simulation.py)
         (x0, y0), (x1, y1) = d.bbox
         tol = 1e-9 * max(x1 - x0, y1 - y0)
-        for i, ch in enumerate(ex.charges):
-            (a0, b0), (a1, b1) = ch.bbox
+        for key, ch, _ in shapes:
+            (a0, b0), (a1, b1) = _modelled_box(ch.bbox, geom)
             if a0 < x0 - tol or b0 < y0 - tol or a1 > x1 + tol or b1 > y1 + tol:
-                raise ValueError(f"explosive.charges[{i}]: lies outside the rock's box {_fmt((x0, y0))}–{_fmt((x1, y1))} "
+                raise ValueError(f"{key}: lies outside the rock's box {_fmt((x0, y0))}–{_fmt((x1, y1))} "
                                  "that the default grid covers; give explosive.grid.bounds or explosive.grid.margin")
 
 
