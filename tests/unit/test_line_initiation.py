@@ -107,6 +107,19 @@ def test_solver_lights_particles_from_lines_and_points():
     np.testing.assert_allclose(s.light_time.numpy(), expect, rtol=1e-10)
 
 
+def test_simultaneous_line_is_a_plane_wave():
+    """simultaneous = true: every cord point fires at t0, so X lights at t0 + dist(X, segment)/D (the v -> inf
+    limit), and particles abeam the cord light by their distance to its line alone (a plane front)."""
+    s = MPMSolver(_cfg(detonation_lines=[{"start": tuple(A), "end": tuple(B), "delay": T0, "simultaneous": True}]))
+    x = s.x.numpy()
+    np.testing.assert_allclose(s.light_time.numpy(), T0 + _seg_dist(x, A, B) / D, rtol=1e-13)
+    abeam = (x[:, 1] > A[1]) & (x[:, 1] < B[1])
+    assert abeam.sum() > 10
+    np.testing.assert_allclose(s.light_time.numpy()[abeam], T0 + np.abs(x[abeam, 0] - A[0]) / D, rtol=1e-12)
+    with pytest.raises(ValidationError, match="not allowed with simultaneous"):
+        _cfg(detonation_lines=[{"start": tuple(A), "end": tuple(B), "simultaneous": True, "velocity": 9000.0}])
+
+
 def test_line_validation():
     # a cord crossing the charge with both ends outside it is accepted
     _cfg(detonation_lines=[{"start": (-0.01, 0.0), "end": (0.03, 0.0)}])

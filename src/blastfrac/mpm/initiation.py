@@ -79,7 +79,8 @@ def body_lighting_times(x: np.ndarray, vol: np.ndarray, cid: np.ndarray, charges
     """t_l [s] of each point (initial positions x [n,2] m, areas vol [n] m², charge index cid [n]).
 
     charges: the scenario's charges (``contains``, ``meets_segment``, ``kind``); points [k,2] m with delays [k] s;
-    lines: DetonationLine items (start, end, delay, velocity or None = D); D [m/s]. Points of a body that no
+    lines: DetonationLine items (start, end, delay, velocity or None = D, simultaneous: the whole line at delay);
+    D [m/s]. Points of a body that no
     initiator reaches get +inf.
     """
     x = np.asarray(x, float).reshape(-1, 2)
@@ -108,7 +109,7 @@ def body_lighting_times(x: np.ndarray, vol: np.ndarray, cid: np.ndarray, charges
                 tb = delay + _path_lengths(x[sel], h, seeds, d[seeds]) / D
             t[sel] = np.minimum(t[sel], tb)
     for dl in lines:
-        vel = dl.velocity if dl.velocity is not None else D
+        vel = np.inf if getattr(dl, "simultaneous", False) else (dl.velocity if dl.velocity is not None else D)
         hit = {int(body[k]) for k, ch in enumerate(charges) if ch.meets_segment(dl.start, dl.end)}
         for b in hit:
             sel = np.flatnonzero(pbody == b)

@@ -198,7 +198,9 @@ class DetonationPoint(_Model):
 class DetonationLine(_Model):
     """A line initiator (detonating cord) from ``start`` to ``end``, fired at ``start`` at ``delay``; its front runs
     along the segment at ``velocity``: the point at distance s from ``start`` lights at delay + s / velocity, and a
-    particle at X lights at min over the segment points y of (their lighting time + |X - y| / D)."""
+    particle at X lights at min over the segment points y of (their lighting time + |X - y| / D).  With
+    ``simultaneous`` the whole segment fires at ``delay`` (a plane-wave generator: in 2D the initiating plane is
+    this line), and X lights at delay + dist(X, segment) / D."""
 
     start: Point = Field(description="end of the cord that is fired (x, y) [m]")
     end: Point = Field(description="other end of the cord (x, y) [m]")
@@ -206,11 +208,17 @@ class DetonationLine(_Model):
     velocity: float | None = Field(
         default=None, gt=0, description="speed of the lighting front along the cord [m/s]; default: the explosive's D"
     )
+    simultaneous: bool = Field(
+        default=False, description="fire the whole line at ``delay`` (plane-wave initiation); excludes ``velocity``"
+    )
 
     @model_validator(mode="after")
     def _length(self) -> DetonationLine:
         if self.start == self.end:
             raise ValueError("end: equals start; a detonation line needs two distinct ends")
+        if self.simultaneous and self.velocity is not None:
+            raise ValueError("velocity: not allowed with simultaneous = true (the whole line fires at its delay); "
+                             "give one or the other")
         return self
 
 
