@@ -133,9 +133,21 @@ def estimate_elements(geom) -> tuple[int | None, str, float]:
     return n, how, (integral - base) / integral if integral > 0 else 0.0
 
 
-def estimate_particles(ex) -> int:
+def _mpm_regions(ex, geom=None) -> list:
+    """The charges (cut at geometry.symmetry's lines when a geometry is given: a half or quarter model seeds the
+    modelled part only) and the elastic bodies: every region the run fills with material points."""
+    charges = list(ex.charges)
+    if geom is not None and getattr(geom, "symmetry", None):
+        from ..mpm.seeding import cut_charges
+
+        charges = cut_charges(charges, geom.symmetry_lines())
+    return charges + list(getattr(ex, "bodies", []) or [])
+
+
+def estimate_particles(ex, geom=None) -> int:
+    """Material points the run seeds: the charges' (modelled part) and bodies' area over the point spacing²."""
     s = ex.grid.cell_size / ex.grid.points_per_cell
-    return int(round(sum(ch.area for ch in ex.charges) / s**2))
+    return int(round(sum(r.area for r in _mpm_regions(ex, geom)) / s**2))
 
 
 def estimate_grid_nodes(ex, geom) -> int:
@@ -144,7 +156,7 @@ def estimate_grid_nodes(ex, geom) -> int:
     if g.bounds is not None:
         (x0, y0), (x1, y1) = g.bounds
     else:
-        boxes = [ch.bbox for ch in ex.charges]
+        boxes = [r.bbox for r in _mpm_regions(ex, geom)]
         (x0, y0), (x1, y1) = (min(b[0][0] for b in boxes), min(b[0][1] for b in boxes)), \
                              (max(b[1][0] for b in boxes), max(b[1][1] for b in boxes))
         if g.margin is None and geom.mesh_file is None:
@@ -160,7 +172,7 @@ def estimate_grid_nodes(ex, geom) -> int:
 def estimate(scenario) -> SizeEstimate:
     elements, how, near = estimate_elements(scenario.geometry)
     ex = scenario.explosive
-    particles = estimate_particles(ex) if ex is not None else 0
+    particles = estimate_particles(ex, scenario.geometry) if ex is not None else 0
     nodes = estimate_grid_nodes(ex, scenario.geometry) if ex is not None else 0
     return SizeEstimate(elements, particles, nodes, how, near)
 
@@ -183,8 +195,8 @@ def check_sizes(scenario, force: bool = False) -> SizeEstimate:
     if est.particles > MAX_PARTICLES:
         ex = scenario.explosive
         raise ScenarioError(
-            f"explosive.grid.cell_size: the charges would hold about {est.particles:,} material points (charge area "
-            f"{sum(c.area for c in ex.charges):.4g} m², spacing cell_size/points_per_cell = "
+            f"explosive.grid.cell_size: the charges and bodies would hold about {est.particles:,} material points "
+            f"(area {sum(r.area for r in _mpm_regions(ex, scenario.geometry)):.4g} m², spacing cell_size/points_per_cell = "
             f"{ex.grid.cell_size / ex.grid.points_per_cell:.4g} m), above the limit of {MAX_PARTICLES:,}; use a "
             f"larger explosive.grid.cell_size or fewer points_per_cell{hint}")
     if est.grid_nodes > MAX_GRID_NODES:
