@@ -2,12 +2,27 @@
 
 from __future__ import annotations
 
+import numpy as np
 import warp as wp
 
+from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.kernels_p2g import particle_stencil
 from blastfrac.mpm.shape import wrap_index
 
 F64 = wp.float64
+
+
+@wp.func
+def blend_heat(m: wp.float64, v_flip: wp.vec2d, v_new: wp.vec2d):
+    """½ m (|v_flip|² − |v_new|²) [J/m]: the kinetic energy a point of mass m [kg/m] loses when its FLIP velocity
+    v_flip is blended towards the grid's (PIC) velocity into v_new [m/s]."""
+    return F64(0.5) * m * (wp.dot(v_flip, v_flip) - wp.dot(v_new, v_new))
+
+
+def blend_heat_np(m, v_flip, v_new):
+    """NumPy twin of :func:`blend_heat` (arrays [n], [n, 2], [n, 2])."""
+    v_flip, v_new = np.asarray(v_flip, float), np.asarray(v_new, float)
+    return 0.5 * np.asarray(m, float) * ((v_flip * v_flip).sum(-1) - (v_new * v_new).sum(-1))
 
 
 @wp.kernel
@@ -26,10 +41,18 @@ def g2p_velocity(
     kind: int,
     l: wp.float64,
     flip: wp.float64,
+    heating: int,
+    mass: wp.array(dtype=wp.float64),
+    mat_kind: wp.array(dtype=wp.int32),
     v: wp.array(dtype=wp.vec2d),
     v_pic: wp.array(dtype=wp.vec2d),
+    ie: wp.array(dtype=wp.float64),
 ):
-    """v_p = flip (v_p + sum N dv_I) + (1 - flip) sum N v_I; v_pic = sum N v_I moves the particle [m/s]."""
+    """v_p = flip (v_p + sum N dv_I) + (1 - flip) sum N v_I; v_pic = sum N v_I moves the particle [m/s].
+
+    With ``heating`` (``explosive.blend_heating``) a gas point's internal energy ie [J/m] takes the kinetic energy
+    that the PIC share removes from it, ½ m (|v_FLIP|² − |v_p|²) with v_FLIP = v_p + sum N dv_I: the blend then
+    exchanges energy as pure FLIP does (:func:`blend_heat`)."""
     p = wp.tid()
     if active[p] == 0:
         return
@@ -43,7 +66,11 @@ def g2p_velocity(
             N = wx[i] * wy[j]
             vp += N * g_vel[n]
             dv += N * g_dvel[n]
-    v[p] = flip * (v[p] + dv) + (F64(1.0) - flip) * vp
+    v_flip = v[p] + dv
+    v_new = flip * v_flip + (F64(1.0) - flip) * vp
+    if heating != 0 and mat_kind[p] == MAT_GAS:      # an elastic body's energy is not heat: not booked
+        ie[p] = ie[p] + blend_heat(mass[p], v_flip, v_new)
+    v[p] = v_new
     v_pic[p] = vp
 
 

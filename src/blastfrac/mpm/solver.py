@@ -68,6 +68,7 @@ class MPMOptions:
     ppc: int = 2
     transfer: str = "flip"
     flip: float = 1.0
+    blend_heating: bool = False
     cfl: float = 0.2
     q1: float = 1.5
     q2: float = 0.06
@@ -179,6 +180,7 @@ class MPMSolver:
             ppc=config.grid.points_per_cell,
             transfer=config.transfer,
             flip=config.flip,
+            blend_heating=config.blend_heating,
             cfl=config.cfl,
             q1=config.q1,
             q2=config.q2,
@@ -500,8 +502,9 @@ class MPMSolver:
             wp.launch(
                 g2p_velocity,
                 dim=self.n,
-                inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip)],
-                outputs=[self.v, self.v_pic],
+                inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip),
+                        int(bool(self.opts.blend_heating) and self.opts.flip < 1.0), self.mass, self.mat_kind],
+                outputs=[self.v, self.v_pic, self.ie],
                 device=d,
             )
         wp.launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 0], outputs=[g.mass, g.mom, g.force],

@@ -318,11 +318,18 @@ class ExplosiveConfig(_Model):
         "Measured (docs/explosive.md): in Sod's tube at 400 cells APIC's velocity scatters 1.4 % behind the shock "
         "(FLIP 14 %) and overshoots by 12 % (FLIP 46 %), but its transfers lose 12 % of the kinetic energy (FLIP 0.5 %), "
         "its shock lags 2.5 cells, and a wall-initiated slab delivers 2.4 % less impulse than exact (FLIP within 0.7 %), "
-        "hence FLIP stays the default"
+        "hence the FLIP blend stays the default"
     )
     flip: float = Field(
         default=1.0, ge=0, le=1, description="FLIP fraction of the FLIP/PIC velocity blend (1 = pure FLIP, as MPM3D; "
-        "0 = PIC), used when transfer = 'flip' [-]"
+        "0 = PIC), used when transfer = 'flip' [-]. "
+        "0.99 with blend_heating removes pure FLIP's long-run noise in a sealed hole but changes the near-wall "
+        "damage (docs/explosive.md 'Velocity transfer'), so 1.0 stays the default"
+    )
+    blend_heating: bool = Field(
+        default=True, description="with transfer = 'flip' and flip < 1: the kinetic energy the PIC share removes "
+        "from each gas point, ½m(|v_FLIP|² − |v|²), goes into its internal energy, so the blend damps the "
+        "particles' velocity noise without losing energy (docs/explosive.md, 'Velocity transfer')"
     )
     cfl: float = Field(default=0.2, gt=0, le=0.5, description="CFL factor alpha in dt = alpha h / max(c + |v|) [-]")
     q1: float = Field(default=1.5, ge=0, le=10, description="quadratic artificial-viscosity coefficient Q1 [-]")
