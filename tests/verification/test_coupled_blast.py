@@ -91,7 +91,9 @@ def test_small_coupled_blast(blast):
     # the charge burns completely: released energy = E0 × charge area
     assert abs(e["explosive_released"] / (E0_TABLE1 * np.pi * R_B**2) - 1) < 1e-9
     assert abs(e["budget_error_relative"]) < 0.05
-    # a crushed zone at the wall, of the size the empirical formulas bracket
+    # a crushed zone at the wall, of the size the empirical formulas bracket. Known limit (docs/explosive.md, "Velocity
+    # transfer"): at this resolution (5 cells across the radius) r_c is not converged; with the rock mesh and the
+    # MPM cell halved it is 1.12 r_b, below the bracket, with pure FLIP and with the 1 % PIC blend alike
     assert lo <= c["crushed_zone_radius_over_rb"] <= hi
     # radial cracks outside it: several, reaching well beyond the crushed zone, tensile ones mostly radial
     assert c["radial_crack_count"] >= 6                  # 6–12 dominant radial cracks is the rule of thumb
