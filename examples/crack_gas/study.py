@@ -761,7 +761,6 @@ def main(argv: list[str] | None = None) -> int:
         all_runs[ex] = runs
         res = {"cases": {k: case_metrics(d, wall[k]) for k, d in runs.items()}, "tables": tables}
         center = np.zeros(2)
-        r_b = 0.005
         # wall-load check: the load the table pulse of c / d put on the wall, measured as borehole_pressure.csv
         # measures a coupled run's (gas_load.csv → wall), against the coupled run's csv it came from
         check = {}

@@ -1,7 +1,6 @@
 """A detonation travels through explosive only (mpm/initiation.py; issue 15 item 3): a point lights the body it
 lies in, a delay means what a blaster means by it, and a non-convex charge lights along paths inside it."""
 
-import math
 
 import numpy as np
 import pytest

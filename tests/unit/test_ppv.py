@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 import warp as wp
 
-from blastfrac.analysis.ppv import (PeakVelocity, damage_radius, fit_attenuation, ppv_critical, ring_profile,
-                                    vibration_report)
+from blastfrac.analysis.ppv import (PeakVelocity, ppv_critical, vibration_report)
 
 
 def test_accumulator_keeps_the_peak_speed_of_every_node():

@@ -49,7 +49,6 @@ def contact_force(
     half = wp.float64(0.5)
     xn = x[n]
     best = int(st[0])
-    best_g = st[2]
     near_inside = st[4] > zero
     prev = contact_slot[n]
     p_prev = contact_p[n]

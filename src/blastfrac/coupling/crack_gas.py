@@ -202,7 +202,7 @@ class CrackGas:
     def apply(self, state, dt: float) -> None:
         """Stage between the particle–edge contact and P2G: cell pressures and face forces (into f_nodes;
         ``add_loads`` adds them to state.f), then this step's flow along the network and at the mouths."""
-        m, d = self.model, self.device
+        d = self.device
         if self._since >= self.rebuild_interval:
             self.rebuild(state)
         self._since += 1
