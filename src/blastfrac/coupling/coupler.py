@@ -15,6 +15,7 @@ import math
 import numpy as np
 import warp as wp
 
+from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
 from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, accumulate_gas_contact_work,
                               accumulate_rock_contact_work, add_node_loads, collect_exposed_elements,
@@ -118,9 +119,16 @@ class GasRockCoupler:
         m = self.model
         self.count.zero_()
         self.reach_max.zero_()
-        sp = self.mpm.spec
-        lo = wp.vec2d(sp.x0, sp.y0)
-        hi = wp.vec2d(sp.x0 + (sp.nx - 1) * sp.h, sp.y0 + (sp.ny - 1) * sp.h)
+        # the elements a particle can reach before the next rebuild: within the MPM grid's active node box (which
+        # holds every particle until its next renewal, mpm/grid.py), widened by a cell per step to this list's next
+        # rebuild plus one renewal period (a particle moves less than a cell per step); not the whole grid, whose
+        # far-field boundary elements would set a large search radius for every particle
+        sp, g = self.mpm.spec, self.mpm.grid
+        grow = (self.rebuild_interval + BOX_STEPS) * sp.h
+        i0, j0, i1, j1 = g.box
+        lo = wp.vec2d(max(sp.x0, sp.x0 + i0 * sp.h - grow), max(sp.y0, sp.y0 + j0 * sp.h - grow))
+        hi = wp.vec2d(min(sp.x0 + (sp.nx - 1) * sp.h, sp.x0 + i1 * sp.h + grow),
+                      min(sp.y0 + (sp.ny - 1) * sp.h, sp.y0 + j1 * sp.h + grow))
         margin = wp.float64((1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max)
         wp.launch(collect_exposed_elements, dim=m.element_count,
                   inputs=[self.slot_iface, state.pair_mode, state.x, self.elem_reach, lo, hi, margin],
