@@ -15,7 +15,7 @@ from .heterogeneity import interface_factors, rms
 from ..materials.interface import softening_slope
 from ..scenario.schema import Scenario
 from .model import Model
-from .topology import Topology, build_topology
+from .topology import build_topology
 
 
 #: consistent-mass fraction θ of each rock.mass_matrix choice
@@ -60,8 +60,9 @@ class ModelBuilder:
             kn_a = rock.spring_penalty * rock.plane_strain_modulus / hbar
             ks_a = kn_a.copy()
         # heterogeneous rock: one unit-mean Weibull factor per interface and property, shared by the
-        # interface's two springs (model/heterogeneity.py); {} for a homogeneous rock
-        self.factors = interface_factors(rock.heterogeneity, len(L), sc.simulation.seed)
+        # interface's two springs (model/heterogeneity.py), times (L_ref/L_q)^(1/m) on the strengths with
+        # reference_length (weakest-link size scaling); {} for a homogeneous rock
+        self.factors = interface_factors(rock.heterogeneity, len(L), sc.simulation.seed, L)
         kn_min_nominal = float(kn_a.min()) if len(kn_a) else 1.0
         ks_min_nominal = float(ks_a.min()) if len(ks_a) else 1.0
         if "stiffness" in self.factors:

@@ -17,6 +17,16 @@ same field, each property has its own stream (adding ``stiffness`` to the list l
 was), and ``correlated = true`` gives every listed property the ``tensile_strength`` stream's draw (one
 weak interface is weak in tension and shear alike; switching correlation leaves T unchanged).
 
+Weakest-link size scaling (``reference_length`` L_ref, off by default): the strength factors of an interface
+of length L_q (``tensile_strength`` and ``cohesion``, not ``stiffness``) are multiplied by
+
+    s_q = (L_ref/L_q)^(1/m),
+
+so that interface q survives a uniform stress σ with P_q = exp(−(L_q/L_ref)(σ/(λ·T̄))^m) and a crack path
+of interfaces survives with P_s = exp(−Σ L_q/L_ref·(σ/(λ·T̄))^m): a function of the path's length alone,
+however many interfaces it is cut into. ``tensile_strength`` and ``cohesion`` are then the mean strengths of
+an interface of length L_ref (an interface of length L has mean T̄·(L_ref/L)^(1/m)).
+
 Consequences handled in the builder (model/builder.py, docs/heterogeneity.md):
 - fracture energies: the spring kernels take one softening rate per model, so the rate is the homogeneous
   rule at the area-weighted rms strength, s = T_rms²/(2(G_f − T_rms²/(2k_min))). Interface q then dissipates
@@ -73,17 +83,42 @@ def draw(m: float, n: int, seed: int, field: str = "tensile_strength") -> np.nda
     return stream(seed, field).weibull(m, n) * weibull_scale(m)
 
 
-def interface_factors(cfg, n_interfaces: int, seed: int) -> dict[str, np.ndarray]:
-    """Factor w_q per interface [Q] for each listed property of a ``HeterogeneityConfig``; {} when homogeneous
-    (``weibull_modulus`` None)."""
+#: the properties that are strengths: the weakest-link size scaling applies to these only
+STRENGTH_FIELDS = ("tensile_strength", "cohesion")
+
+
+def size_factor(lengths: np.ndarray, reference_length: float, m: float) -> np.ndarray:
+    """Weakest-link strength scale (L_ref/L_q)^(1/m) of interfaces of length L_q [m] [-]."""
+    lengths = np.asarray(lengths, float)
+    return np.power(float(reference_length) / lengths, 1.0 / float(m))
+
+
+def weakest_link_survival(stress: float, total_length: float, mean_strength: float, m: float,
+                          reference_length: float) -> float:
+    """P_s = exp(−(ℓ/L_ref)(σ/(λ·T̄))^m): survival of a path of total length ℓ [m] under a uniform stress σ
+    when interfaces of length L_ref have unit-mean Weibull strengths of mean T̄ (size-scaled field) [-]."""
+    return math.exp(-(total_length / reference_length) * (stress / (weibull_scale(m) * mean_strength)) ** m)
+
+
+def interface_factors(cfg, n_interfaces: int, seed: int, lengths: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """Factor per interface [Q] for each listed property of a ``HeterogeneityConfig``; {} when homogeneous
+    (``weibull_modulus`` None). The drawn unit-mean factor w_q, times the weakest-link scale
+    (L_ref/L_q)^(1/m) on the strengths when ``reference_length`` is set (then ``lengths`` [m], [Q], is needed)."""
     if cfg is None or cfg.weibull_modulus is None:
         return {}
     m = float(cfg.weibull_modulus)
+    l_ref = getattr(cfg, "reference_length", None)
+    scale = None
+    if l_ref is not None:
+        if lengths is None or len(lengths) != n_interfaces:
+            raise ValueError("reference_length: the size scaling needs the interface lengths")
+        scale = size_factor(lengths, l_ref, m)
     out: dict[str, np.ndarray] = {}
     shared = draw(m, n_interfaces, seed, FIELDS[0]) if cfg.correlated else None
     for f in FIELDS:
         if f in cfg.fields:
-            out[f] = shared if shared is not None else draw(m, n_interfaces, seed, f)
+            w = shared if shared is not None else draw(m, n_interfaces, seed, f)
+            out[f] = w * scale if (scale is not None and f in STRENGTH_FIELDS) else w
     return out
 
 

@@ -110,6 +110,14 @@ class HeterogeneityConfig(_Strict):
         True, description="One factor per interface shared by every listed property (a weak interface is weak in "
         "tension and shear alike); false: an independent draw per property.",
     )
+    reference_length: float | None = Field(
+        None, gt=0, description="Weakest-link size scaling [m], > 0; None (default) = none (i.i.d. factors "
+        "whatever the interface length). Set: the strength factors (tensile_strength, cohesion; not stiffness) "
+        "of an interface of length L are multiplied by (reference_length/L)^(1/m), so a crack path of length l "
+        "survives a uniform stress s with exp(−(l/L_ref)(s/(λT))^m) however many interfaces it is cut into; "
+        "tensile_strength and cohesion are then the mean strengths of an interface of length reference_length. "
+        "Ignored while weibull_modulus is None.",
+    )
 
     @field_validator("fields")
     @classmethod
