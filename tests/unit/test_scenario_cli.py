@@ -76,6 +76,14 @@ def test_check_prints_counts(capsys):
     out = capsys.readouterr().out
     for word in ("elements", "springs", "stable dt", "steps to end time", "memory"):
         assert word in out
+    assert "heterogeneity" not in out                      # homogeneous rock: no row
+    assert main(["check", str(DEMO), "--set", "rock.heterogeneity.weibull_modulus=5",
+                 "--set", "rock.heterogeneity.reference_length=0.002"]) == 0
+    out = capsys.readouterr().out
+    # CV of the unit-mean Weibull variable at m = 5: sqrt(Γ(1.4) − Γ(1.2)²)/Γ(1.2)
+    import math
+    cv = math.sqrt(math.gamma(1.4) - math.gamma(1.2) ** 2) / math.gamma(1.2)
+    assert f"Weibull m = 5 (CV {cv:.3f})" in out and "L_ref = 0.002 m" in out
 
 
 def test_run_writes_all_outputs(tmp_path):

@@ -110,6 +110,15 @@ def run(args) -> int:
         ("memory (model + state)", f"{(model_bytes(m) + state_bytes) / 2**20:.1f} MiB"),
         ("output directory", sc.output.directory),
     ]
+    het = sc.rock.heterogeneity
+    if het.active:                            # Weibull spring properties (docs/heterogeneity.md)
+        from ..model.heterogeneity import weibull_cv
+
+        scaling = (f", weakest-link scaling to L_ref = {het.reference_length:.4g} m" if het.reference_length
+                   else ", no size scaling")
+        rows.append(("heterogeneity", f"Weibull m = {het.weibull_modulus:g} (CV {weibull_cv(het.weibull_modulus):.3f}) "
+                     f"on {', '.join(het.fields)}{', correlated' if het.correlated else ''}{scaling}, "
+                     f"seed {sc.simulation.seed}"))
     if sc.geometry.symmetry:                  # a half or quarter model (docs/explosive.md)
         from ..analysis.symmetry import describe
 
