@@ -20,6 +20,7 @@ from ._warp import resolve_device
 from .analysis.energy import budget_error, gas_energies, rock_energies
 from .analysis.fracture import FractureDegree, joint_spring_mask
 from .analysis.monitors import MonitorSet
+from .blowup import diagnose_nonfinite
 from .cdem.solver import CDEMSolver
 from .io.paraview import GasSeries, ParaviewSeries, crack_segments, joint_segments
 from .io.tables import CsvHistory, monitor_unit, write_summary
@@ -564,76 +565,8 @@ class Simulation:
 
     def _guard(self, e: dict) -> None:
         if not all(math.isfinite(v) for v in e.values()):
-            msg, details = self._diagnose_nonfinite(e)
+            msg, details = diagnose_nonfinite(self, e)
             raise SimulationError(msg, details)
-
-    def _diagnose_nonfinite(self, e: dict) -> tuple[str, dict]:
-        """Where the run blew up: the first non-finite rock node, element and gas particle, and a likely cause."""
-        st, X = self.state, self.model.host["node_X"]
-        bad_terms = [k for k, v in e.items() if not math.isfinite(v)]
-        details: dict = {"step": self.steps, "time": self.time, "time_step": self.dt,
-                         "stable_time_step": self.model.stable_dt, "non_finite_energy_terms": bad_terms}
-        where: list[str] = []
-        x, v, sig = st.x.numpy(), st.v.numpy(), st.sigma.numpy()
-        bad_n = np.flatnonzero(~(np.isfinite(x).all(1) & np.isfinite(v).all(1)))
-        if len(bad_n):
-            n = int(bad_n[0])
-            pos = [float(c) for c in X[n]]
-            details["node"] = {"index": n, "reference_position": pos, "count": int(len(bad_n))}
-            where.append(f"rock node {n} at (x, y) = ({pos[0]:.4g}, {pos[1]:.4g}) m ({len(bad_n)} nodes non-finite)")
-        bad_e = np.flatnonzero(~np.isfinite(sig).all(1))
-        if len(bad_e):
-            k = int(bad_e[0])
-            c = X[3 * k:3 * k + 3].mean(axis=0)       # elements own their 3 nodes (blocks: nodes 3k, 3k+1, 3k+2)
-            details["element"] = {"index": k, "reference_centroid": [float(c[0]), float(c[1])], "count": int(len(bad_e))}
-            where.append(f"element {k} centred at ({c[0]:.4g}, {c[1]:.4g}) m ({len(bad_e)} elements non-finite)")
-        if not len(bad_n) and len(v):
-            # the state is still finite but its energy sums overflowed: point at the fastest node
-            with np.errstate(over="ignore", invalid="ignore"):
-                speed = np.hypot(v[:, 0], v[:, 1])
-            n = int(np.nanargmax(np.where(np.isfinite(speed), speed, -1.0)))
-            pos = [float(c) for c in X[n]]
-            details["node"] = {"index": n, "reference_position": pos, "speed": float(speed[n]), "count": 0}
-            bad_n = np.array([n])
-            where.append(f"no non-finite value in the state yet (the energy sums overflowed); fastest rock node {n} "
-                         f"at (x, y) = ({pos[0]:.4g}, {pos[1]:.4g}) m, |v| = {speed[n]:.3g} m/s")
-        gas_bad = False
-        if self.gas is not None:
-            f = self.gas.particle_fields()
-            ok = np.isfinite(f["position"]).all(1) & np.isfinite(f["velocity"]).all(1) & np.isfinite(f["pressure"]) \
-                & np.isfinite(f["internal_energy"])
-            bad_p = np.flatnonzero(~ok)
-            if len(bad_p):
-                gas_bad = True
-                i = int(bad_p[0])
-                p = f["position"][i]
-                details["particle"] = {"index": i, "position": [float(c) for c in p], "count": int(len(bad_p))}
-                at = f"at ({p[0]:.4g}, {p[1]:.4g}) m" if np.isfinite(p).all() else "(position non-finite)"
-                where.append(f"gas particle {i} {at} ({len(bad_p)} particles non-finite)")
-        # likely cause
-        causes: list[str] = []
-        near_load = False
-        if "node" in details:
-            loaded = np.unique(np.r_[self.model.host.get("ledge_n0", []), self.model.host.get("ledge_n1", [])])
-            near_load = bool(len(loaded)) and bool(np.isin(bad_n, loaded.astype(np.int64)).any())
-        if gas_bad or "contact_energy" in bad_terms:
-            causes.append("the gas-rock contact (lower coupling.stiffness_factor / coupling.contact_stiffness, or "
-                          "simulation.dt_safety)")
-        if near_load:
-            causes.append("a pressure pulse on a loaded boundary or borehole (check its peak [Pa] and rise time)")
-        dt_cause = (f"the time step (dt = {self.dt:.3e} s = {self.dt / self.model.stable_dt:.2f} x the stable "
-                    "rock step; reduce simulation.dt_safety)")
-        if self.dt > self.model.stable_dt * (1 + 1e-9):
-            causes.insert(0, dt_cause)                 # above the stability limit: certainly the time step
-        else:
-            causes.append(dt_cause)
-        details["likely_causes"] = causes
-        details["where"] = where
-        msg = (f"non-finite energy ({', '.join(bad_terms)}) at step {self.steps} (t = {self.time:.4e} s); "
-               f"first non-finite: {'; '.join(where) if where else 'no node, element or particle (energy sums only)'}. "
-               f"Likely cause: {causes[0]}" + (f"; else {'; '.join(causes[1:])}" if len(causes) > 1 else "")
-               + f". The histories up to here and summary.json (status 'failed') are in {self.out_dir}")
-        return msg, details
 
     # ------------------------------------------------------------------ results
     def summary(self, wall: float) -> dict:
