@@ -173,6 +173,10 @@ class Grid:
         m = BOX_MARGIN
         self.box_i0, self.box_i1 = (0, s.nx - 1) if s.periodic_x else (max(0, e0 - m), min(s.nx - 1, e1 + 2 + m))
         self.box_j0, self.box_j1 = (0, s.ny - 1) if s.periodic_y else (max(0, f0 - m), min(s.ny - 1, f1 + 2 + m))
+        self.reset_extent()
+
+    def reset_extent(self) -> None:
+        """Empty the accumulated particle extent (the particle update then widens it again)."""
         self.extent.assign(np.array(_NO_EXTENT, dtype=np.int32))
 
     def set_walls(self, xmin=None, xmax=None, ymin=None, ymax=None, kind: str = "slip") -> None:

@@ -429,7 +429,7 @@ class MPMSolver:
     def _init_active_box(self) -> None:
         """The grid's active node box around the seeded particles (:mod:`blastfrac.mpm.grid`)."""
         s = self.spec
-        self.grid.extent.assign(np.array([2**30, 2**30, -1, -1], dtype=np.int32))
+        self.grid.reset_extent()
         wp.launch(particle_extent, dim=self.n, inputs=[self.active, self.x, F64(s.x0), F64(s.y0), F64(1.0 / s.h)],
                   outputs=[self.grid.extent], device=self.device)
         self.grid.renew_box(check=False)
