@@ -48,7 +48,7 @@ def _restore(sim, snap: dict) -> None:
         getattr(c, k).assign(snap["c_" + k])
     sim.time, sim.cdem.dt_prev = snap["time"], snap["dt_prev"]
     c._step, c.active = snap["step"], snap["active"]
-    c._since_build = c.rebuild_interval          # the hash is rebuilt at the first step
+    c._built = False                             # the hash is rebuilt at the first step
 
 
 def _time_steps(sim, steps: int, warm: int = 3) -> tuple[float, float]:

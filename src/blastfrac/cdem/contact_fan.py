@@ -185,6 +185,76 @@ def held_search(
     return st
 
 
+@wp.func
+def point_segment_distance(p: wp.vec2d, a: wp.vec2d, b: wp.vec2d):
+    """Distance from point p to the segment a–b [m]."""
+    ab = b - a
+    t = wp.clamp(wp.dot(p - a, ab) / wp.dot(ab, ab), wp.float64(0.0), wp.float64(1.0))
+    return wp.length(p - (a + t * ab))
+
+
+@wp.func
+def far_nodes_near(other: wp.int32, xa: wp.vec2d, xn: wp.vec2d, xb: wp.vec2d, x: wp.array(dtype=wp.vec2d),
+                   wake_dist: wp.float64):
+    """True if one of the two nodes of other's element that are not at the shared vertex is within wake_dist of
+    the open node's element edges a–n or n–b."""
+    near = bool(False)
+    for k in range(2):
+        q = slot_end(other)
+        if k == 1:
+            q = slot_prev(other)
+        xq = x[q]
+        if point_segment_distance(xq, xa, xn) < wake_dist or point_segment_distance(xq, xn, xb) < wake_dist:
+            near = True
+    return near
+
+
+@wp.func
+def fan_wake(
+    n: wp.int32,
+    excl: wp.int64,
+    use_cache: wp.int32,
+    node_vertex: wp.array(dtype=wp.int32),
+    vertex_start: wp.array(dtype=wp.int32),
+    vertex_nodes: wp.array(dtype=wp.int32),
+    fan_index: wp.array(dtype=wp.int32),
+    slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    fan_cand: wp.array2d(dtype=wp.int32),
+    fan_count: wp.array(dtype=wp.int32),
+    wake_dist: wp.float64,
+    step: wp.int32,
+    elem_near: wp.array(dtype=wp.int32),
+):
+    """Wake (elem_near) the blocks of open node n's fan candidates whose other nodes come within wake_dist of n's
+    element edges at the vertex: those nodes could enter n's block through an edge that is not at their own
+    vertex, which their fan search does not see (cdem/contact.py, "Cost"). The edges that end at the vertex
+    itself touch n there and say nothing about that, so they do not wake a block."""
+    xn = x[n]
+    xa = x[slot_prev(n)]
+    xb = x[slot_end(n)]
+    cnt = wp.int32(-1)
+    if use_cache != 0:
+        cnt = fan_count[n]
+    if cnt >= 0:
+        for k in range(cnt):
+            other = fan_cand[n, k] >> 2
+            if far_nodes_near(other, xa, xn, xb, x, wake_dist):
+                elem_near[other // 3] = step
+    else:
+        e = n // 3
+        vtx = node_vertex[n]
+        for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
+            other = vertex_nodes[j]
+            if other // 3 != e:
+                if not in_mask(excl, other, fan_index):
+                    if slot_exposed(other, slot_iface, pair_mode) or slot_exposed(slot_prev(other), slot_iface,
+                                                                                  pair_mode):
+                        if far_nodes_near(other, xa, xn, xb, x, wake_dist):
+                            elem_near[other // 3] = step
+
+
 @wp.kernel
 def mark_pair_changes(
     pair_mode: wp.array(dtype=wp.int32),
@@ -347,6 +417,8 @@ def select_contact_nodes(
         return
     is_open = flag == 2
     woken = node_woken(n // 3, elem_near, step, near_window)
+    # open nodes are listed whenever they have a fan (its search and fan_wake run every step), the hash search
+    # when due
     if not (is_open or woken):
         if contact_slot[n] < 0:
             if held_faces == 0:
@@ -372,7 +444,7 @@ def select_contact_nodes(
                             hit = edge_may_take(xn, x[sb], xc, e1, e2)
                 if not hit:
                     return
-    # an open node whose last search found nothing within reach skips the search (BlockContact doc)
-    elif is_open and not woken and step < query_after[n] and contact_slot[n] < 0:
+    # a quiet open node (BlockContact doc) without contact is left with its fan search: none if its fan is empty
+    elif is_open and not woken and step < query_after[n] and contact_slot[n] < 0 and fan_count[n] == 0:
         return
     node_list[wp.atomic_add(counts, 1, 1)] = n

@@ -33,6 +33,16 @@ def compute_edge_samples(
     points[i] = wp.vec3d(m[0], m[1], wp.float64(0.0))
 
 
+@wp.kernel
+def largest_displacement(x: wp.array(dtype=wp.vec2d), x_build: wp.array(dtype=wp.vec2d),
+                         moved: wp.array(dtype=wp.float64)):
+    """moved[0] = max over the nodes of |x − x_build|² [m²]: how far the hash points may have moved since the hash
+    was built (a point on an edge moves no more than the edge's nodes)."""
+    n = wp.tid()
+    d = x[n] - x_build[n]
+    wp.atomic_max(moved, 0, wp.dot(d, d))
+
+
 @wp.func
 def cell_coord(v: wp.float64):
     """Cell coordinate of a scaled position, as wp.HashGrid computes it (floor, clamped to the int range)."""
@@ -138,6 +148,7 @@ def hash_edge(
     vtx: wp.int32,
     excl: wp.int64,
     is_open: bool,
+    skip_vertex: bool,
     node_vertex: wp.array(dtype=wp.int32),
     fan_index: wp.array(dtype=wp.int32),
     slot_iface: wp.array(dtype=wp.int32),
@@ -151,15 +162,16 @@ def hash_edge(
     sr: vec6d,
 ):
     """hash_search for one exposed edge s of another element within the search radius: sr = (search state of
-    consider_edge, distance to the closest edge). Wakes the edge's block if an open face comes near it."""
+    consider_edge, distance to the closest edge). Wakes the edge's block if an open face comes near it. With
+    skip_vertex the edges that end at the node's own vertex are left out (the fan search has them)."""
     s_end = slot_end(s)
     skip = bool(False)
     corner = wp.int32(-1)
     if node_vertex[s] == vtx:
-        skip = in_mask(excl, s, fan_index)
+        skip = skip_vertex or in_mask(excl, s, fan_index)
         corner = slot_prev(s)
     elif node_vertex[s_end] == vtx:
-        skip = in_mask(excl, s_end, fan_index)
+        skip = skip_vertex or in_mask(excl, s_end, fan_index)
         corner = s_end
     out = sr
     if not skip:
@@ -176,6 +188,8 @@ def hash_edge(
 def hash_search(
     n: wp.int32,
     is_open: bool,
+    skip_vertex: bool,
+    st0: vec5d,
     excl: wp.int64,
     use_cache: wp.int32,
     grid: wp.uint64,
@@ -202,8 +216,9 @@ def hash_search(
     query_after: wp.array(dtype=wp.int32),
 ):
     """Search state (consider_edge) of an open or woken node n over every exposed edge near it, through the
-    spatial hash; excl: its fan_exclusions mask. Wakes the blocks an open face comes near and sets the node's
-    quiet period (BlockContact doc). With use_cache the points come from the cell grid (the cells wp.HashGrid
+    spatial hash, from search state st0; excl: its fan_exclusions mask. With skip_vertex, over those that do not
+    end at the node's own vertex (an open node, whose fan search has those). Wakes the blocks an open face comes
+    near and sets the node's quiet period (BlockContact doc): quiet if no edge it looked at is within wake_dist. With use_cache the points come from the cell grid (the cells wp.HashGrid
     would visit, in its order, each cell's points in its order) with their exposure in sorted_code; without,
     from wp.HashGrid itself."""
     e = n // 3
@@ -213,7 +228,7 @@ def hash_search(
     # the node's element wedge: unit vectors along its two edges at the node
     u1 = wp.normalize(x[slot_end(n)] - xn)
     u2 = wp.normalize(x[slot_prev(n)] - xn)
-    sr = vec6d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero, wp.float64(1.0e300))
+    sr = vec6d(st0[0], st0[1], st0[2], st0[3], st0[4], wp.float64(1.0e300))
     r2 = search_radius * search_radius
     if use_cache != 0:
         xs = cell_coord((xn[0] - search_radius) * cell_inv)
@@ -233,7 +248,7 @@ def hash_search(
                         dy = pt[1] - xn[1]
                         # whole hash cells: keep the points within the search radius
                         if s // 3 != e and dx * dx + dy * dy <= r2:
-                            sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, node_vertex, fan_index, slot_iface,
+                            sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, skip_vertex, node_vertex, fan_index, slot_iface,
                                            pair_mode, x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
     else:
         query = wp.hash_grid_query(grid, wp.vec3d(xn[0], xn[1], zero), search_radius)
@@ -246,9 +261,9 @@ def hash_search(
             # the query returns whole hash cells: keep the points within the search radius
             if s // 3 != e and dx * dx + dy * dy <= r2:
                 if slot_exposed(s, slot_iface, pair_mode):
-                    sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, node_vertex, fan_index, slot_iface, pair_mode,
+                    sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, skip_vertex, node_vertex, fan_index, slot_iface, pair_mode,
                                    x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
     query_after[n] = 0
-    if is_open and sr[0] < zero and sr[5] >= wake_dist:
+    if is_open and sr[5] >= wake_dist:
         query_after[n] = step + quiet_steps
     return vec5d(sr[0], sr[1], sr[2], sr[3], sr[4])

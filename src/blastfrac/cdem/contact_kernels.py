@@ -6,7 +6,7 @@ from __future__ import annotations
 import warp as wp
 
 from ..model.model import CONTACT_DISSIPATED
-from .contact_fan import held_search, node_faces, node_woken
+from .contact_fan import fan_wake, held_search, node_faces, node_woken
 from .contact_geometry import (
     KC_CAP,
     LOSS_PENALTY,
@@ -235,18 +235,31 @@ def eval_block_contact(
     woken = node_woken(n // 3, elem_near, step, near_window)
     if not (is_open or woken) and held_faces == 0 and contact_slot[n] < 0:
         return                                    # held broken faces not searched (BlockContact.held_faces)
-    if is_open and not woken and step < query_after[n] and contact_slot[n] < 0:
-        return
     excl = wp.int64(0)
     if use_cache != 0:
         excl = fan_excl[n]
     else:
         excl = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
     st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
-    if is_open or woken:
-        st = hash_search(n, is_open, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim, cell_starts,
-                         cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index, pair_mode, x,
-                         search_radius, max_depth, touch_tol, wake_dist, step, quiet_steps, elem_near, query_after)
+    if is_open:
+        # the edges at its own vertex from its fan (as a held node), every step; the others through the hash,
+        # unless it is quiet (its last search saw no such edge within wake_dist, BlockContact doc)
+        st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,
+                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count)
+        fan_wake(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface, pair_mode, x,
+                 fan_cand, fan_count, wake_dist, step, elem_near)
+        if woken or step >= query_after[n] or contact_slot[n] >= 0:
+            st = hash_search(n, True, True, st, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim,
+                             cell_starts, cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index,
+                             pair_mode, x, search_radius, max_depth, touch_tol, wake_dist, step, quiet_steps,
+                             elem_near, query_after)
+        elif st[0] < zero:
+            return
+    elif woken:
+        st = hash_search(n, False, False, st, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim,
+                         cell_starts, cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index,
+                         pair_mode, x, search_radius, max_depth, touch_tol, wake_dist, step, quiet_steps,
+                         elem_near, query_after)
     elif held_faces != 0:
         # broken faces still held by their springs, not woken: only the other blocks at the node's vertex
         st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,

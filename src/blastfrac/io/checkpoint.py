@@ -162,8 +162,8 @@ def _width(a: wp.array) -> int:
 
 def _rebuild_hashes(sim) -> None:
     c = getattr(getattr(sim, "cdem", None), "contact", None)
-    if c is not None and getattr(c, "_since_build", c.rebuild_interval) < c.rebuild_interval:
-        c.grid.build(c.points, c.radius)
+    if c is not None and getattr(c, "_built", False) and getattr(c, "_grid_kind", -1) == 0:
+        c.grid.build(c.points, c.radius)                  # wp.HashGrid (fan_cache off); the cell grid is saved
     cp = getattr(sim, "coupler", None)
     if cp is not None and cp.n_exposed and cp._since < cp.rebuild_interval:
         cp.grid.build(cp.points[: cp.n_exposed], cp.query_radius)
