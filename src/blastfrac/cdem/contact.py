@@ -3,13 +3,18 @@
 **Targets and candidates.** Target edges are the *exposed* element edges of METHOD §1.4: mesh-boundary
 edges and interfaces whose two springs have both broken (dropped or not). A node is a candidate if one of
 its own element's edges at it is exposed (the others exit at once). Nodes on an *open* face (a boundary
-edge, or an interface with a dropped pair) are matched to every exposed edge near them through a spatial
-hash (edges sampled at spacing ≤ ℓ_ref, see ``BlockContact``), so the cost is linear in the number of
-nodes. Nodes whose broken faces are all still held by undropped springs, the bulk of a crushed zone, only
-test the other blocks at their own vertex (the nodes of that vertex, a list of ~6, no hash): that is where
-their broken springs can carry them into a block they are not paired with. An open face that comes within
-h_min of such a block "wakes" it for ``near_window`` steps, and its held nodes search the hash too, so they
-cannot enter the open block unseen either. Running over all nodes gives both passes (A→B and B→A).
+edge, or an interface with a dropped pair) are matched to every exposed edge near them: those that end at
+their own vertex through the other blocks of that vertex (its fan), the others through a spatial hash
+(edges sampled at spacing ≤ ℓ_ref, see ``BlockContact``), so the cost is linear in the number of nodes.
+Nodes whose broken faces are all still held by undropped springs, the bulk of a crushed zone, only test the
+other blocks at their own vertex (the nodes of that vertex, a list of ~6, no hash): that is where their
+broken springs can carry them into a block they are not paired with. An open face that comes within h_min of
+such a block "wakes" it for ``near_window`` steps, and its held nodes search the hash too, so they cannot
+enter the open block unseen either: an open node wakes the blocks whose edges not at its vertex are within
+h_min of it (hash) and the blocks of its fan whose other two nodes are within h_min of its own element's
+edges at the vertex (``fan_wake``); an edge that merely ends at the node's vertex touches it there and wakes
+nothing (it did before, which kept every open node of a cracked face searching the hash at every step and
+its fan woken). Running over all nodes gives both passes (A→B and B→A).
 
 **Geometry.** Node x against edge a→b of length L: ξ = (x − x_a)·t̂/L and g = (x − x_a)·n̂ [m],
 with n̂ = (t_y, −t_x) the outward normal of a counter-clockwise element (TriMesh orients them so).
@@ -94,10 +99,11 @@ end of the demo), so the pass works from caches that change only when a spring d
   pass over the nodes of a small mesh.
 
 With ``fan_cache`` off every node is evaluated as before (wp.HashGrid, every held node walks its fan; ~15 %
-slower than the code before the cache, a reference only). Demo end state (3,966 blocks, 36 % of the springs
-broken, benchmarks/contact_cache.py, CPU): the rock step costs ×2.1–2.8 the intact one (×3.6–4.1 before the
-cache, the intact step unchanged); what is left is mostly the contact of ~1,200 held nodes in contact and the
-hash search of ~300 open ones. Before the cache, on 59k elements (CPU): ×1.35 per step on nearly intact rock,
+slower than the code before the cache, a reference only). Demo end state (3,966 blocks, 39.5 % of the springs
+broken, benchmarks/contact_cache.py, CPU): the rock step costs ×2.4 the intact one (×3.6–4.1 before the
+cache); open nodes searching their own vertex through the fan and the hash rebuilt on displacement took
+0.80 → 0.65 ms intact and 1.95 → 1.56 ms cracked. What is left is mostly the contact of ~1,300 held nodes in
+contact (~0.3 ms) and the corner test of ~6,500 held ones in the listing pass (~0.25 ms). Before the cache, on 59k elements (CPU): ×1.35 per step on nearly intact rock,
 ×2.9 with 17 % of the springs broken (×1.4 with ``held_faces`` off, at the price of 0.3·h overlaps in the
 crushed zone).
 
