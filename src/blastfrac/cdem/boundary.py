@@ -41,10 +41,10 @@ def apply_edge_loads(
     wp.atomic_add(f, b, force)
 
 
-def launch_edge_loads(model, state, dt_prev: float) -> None:
+def launch_edge_loads(model, state, dt_prev: float, launch=wp.launch) -> None:
     if model.loaded_edge_count == 0:
         return
-    wp.launch(apply_edge_loads, dim=model.loaded_edge_count,
+    launch(apply_edge_loads, dim=model.loaded_edge_count,
               inputs=[model.ledge_n0, model.ledge_n1, model.ledge_pulse, model.ledge_f0,
                       state.x, state.v, state.pulse_values, wp.float64(dt_prev), state.ledge_fprev],
               outputs=[state.f, state.energy_acc], device=model.device)

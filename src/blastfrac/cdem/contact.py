@@ -95,7 +95,7 @@ end of the demo), so the pass works from caches that change only when a spring d
 - the hash is a cell grid of our own with the cells and the point order of wp.HashGrid (the same points met in the
   same order), each cell's points stored together with the exposure of their edge (kept by mark_pair_changes):
   a query reads memory in sequence and loads no spring state;
-- the launches are recorded once and replayed (``BlockContact._launch``): packing ~50 arguments costs more than a
+- the launches are recorded once and replayed (``_warp.Launcher``): packing ~50 arguments costs more than a
   pass over the nodes of a small mesh.
 
 With ``fan_cache`` off every node is evaluated as before (wp.HashGrid, every held node walks its fan; ~15 %
@@ -121,6 +121,7 @@ import math
 import numpy as np
 import warp as wp
 
+from .._warp import Launcher
 from .contact_fan import (
     list_candidates,
     mark_pair_changes,
@@ -267,26 +268,8 @@ class BlockContact:
         self._cand_count = wp.zeros(1, dtype=wp.int32, device=d)
         self._n_cand = 0
         self._step = 0
-        self._launches: dict = {}
-
-    def _launch(self, kernel, dim: int, params: list) -> None:
-        """wp.launch(kernel, dim, inputs=params) through a recorded launch (wp.launch(record_cmd=True)): packing
-        ~45 arguments costs ~50 µs a launch on a CPU, a replay only sets the scalars that changed. Recorded
-        again whenever an array argument is another object (another State)."""
-        arrays = [a for a in params if isinstance(a, wp.array)]
-        rec = self._launches.get(kernel.key)
-        if rec is None or len(rec[1]) != len(arrays) or any(a is not b for a, b in zip(rec[1], arrays)):
-            cmd = wp.launch(kernel, dim=dim, inputs=params, device=self.model.device, record_cmd=True)
-            rec = (cmd, arrays, list(params))
-            self._launches[kernel.key] = rec
-        else:
-            cmd, _, last = rec
-            for i, a in enumerate(params):
-                if not isinstance(a, wp.array) and a != last[i]:
-                    cmd.set_param_at_index(i, a)
-                    last[i] = a
-            cmd.set_dim(dim)
-        rec[0].launch()
+        # ~50 arguments a launch: packing them costs more than a pass over the nodes of a small mesh
+        self._launch = Launcher()
 
     def apply(self, state, dt: float) -> None:
         """Add the contact forces of the current configuration to state.f; dt [s] drives the friction."""

@@ -92,17 +92,17 @@ def gather_spring_forces(
     f[n] = acc
 
 
-def launch_element_forces(model, state, dt: float) -> None:
-    wp.launch(eval_element_forces, dim=model.element_count,
+def launch_element_forces(model, state, dt: float, launch=wp.launch) -> None:
+    launch(eval_element_forces, dim=model.element_count,
               inputs=[state.x, state.v, state.sigma, wp.float64(model.lam), wp.float64(model.mu),
                       wp.float64(model.density), wp.float64(model.c_p), wp.float64(model.q_quad),
                       wp.float64(model.q_lin), wp.float64(dt)],
               outputs=[state.f, state.energy_acc], device=model.device)
 
 
-def launch_gather_springs(model, state) -> None:
+def launch_gather_springs(model, state, launch=wp.launch) -> None:
     if model.interface_count == 0:
         return
-    wp.launch(gather_spring_forces, dim=model.node_count,
+    launch(gather_spring_forces, dim=model.node_count,
               inputs=[model.node_pairs, model.node_pair_sign, state.pair_force],
               outputs=[state.f], device=model.device)

@@ -145,8 +145,8 @@ def integrate_blocks(
     store_block(v, x, n0, w0, w1, w2, dt)
 
 
-def launch_integrate(model, state, dt: float, alpha: float) -> None:
-    wp.launch(integrate_blocks, dim=model.element_count,
+def launch_integrate(model, state, dt: float, alpha: float, launch=wp.launch) -> None:
+    launch(integrate_blocks, dim=model.element_count,
               inputs=[model.node_mass, model.node_bc, model.bc_P, model.bc_C, state.f,
                       wp.float64(model.mass_theta), wp.float64(alpha), wp.float64(dt)],
               outputs=[state.x, state.v, state.energy_acc], device=model.device)

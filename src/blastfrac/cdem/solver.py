@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
+from .._warp import Launcher
 from ..model.model import Model, State
 from .boundary import launch_edge_loads
 from .contact import BlockContact
@@ -23,6 +24,7 @@ class CDEMSolver:
         use_contact = model.breakable == 1 if block_contact is None else block_contact
         self.contact = BlockContact(model) if use_contact else None
         self.dt_prev = 0.0
+        self.launch = Launcher()                  # recorded launches of the rock stages (_warp.Launcher)
 
     def set_pulses(self, state: State, t: float) -> None:
         """Evaluate every pressure pulse at time t [s] and copy the values to the device."""
@@ -40,20 +42,20 @@ class CDEMSolver:
 
     def forces_springs(self, state: State, dt: float, t: float) -> None:
         """3a: springs, failure, broken-pair contact (after it, pair_mode holds this step's failures)."""
-        launch_spring_forces(self.model, state, dt, t)
+        launch_spring_forces(self.model, state, dt, t, self.launch)
 
     def forces_rest(self, state: State, dt: float, t: float) -> None:
         """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode)."""
-        launch_element_forces(self.model, state, dt)              # 3b CST stress update, f = f_int
-        launch_gather_springs(self.model, state)                  # 3c f += spring forces (gather)
+        launch_element_forces(self.model, state, dt, self.launch)             # 3b CST stress update, f = f_int
+        launch_gather_springs(self.model, state, self.launch)                 # 3c f += spring forces (gather)
         self.set_pulses(state, t)
-        launch_edge_loads(self.model, state, self.dt_prev)        # 3d pressure pulses, in-situ tractions
+        launch_edge_loads(self.model, state, self.dt_prev, self.launch)       # 3d pressure pulses, in-situ tractions
         if self.contact is not None:
             self.contact.apply(state, dt)                         # 3e node-to-edge block contact
 
     def integrate(self, state: State, dt: float, alpha: float = 0.0) -> None:
         """Stage 4: central difference with damping, constraints and dashpots."""
-        launch_integrate(self.model, state, dt, alpha)
+        launch_integrate(self.model, state, dt, alpha, self.launch)
         self.dt_prev = dt
 
     def initialise_stress(self, state: State, sxx: float, syy: float, sxy: float) -> None:

@@ -15,6 +15,7 @@ import math
 import numpy as np
 import warp as wp
 
+from .._warp import Launcher
 from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
 from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, accumulate_gas_contact_work,
@@ -63,6 +64,7 @@ class GasRockCoupler:
         self.elems = wp.zeros(E, dtype=wp.int32, device=d)
         self.points = wp.zeros(E, dtype=wp.vec3d, device=d)
         self.acc = wp.zeros(3, dtype=wp.float64, device=d)
+        self._launch = Launcher()                 # recorded launches of the per-step kernels (_warp.Launcher)
         self.f_react = wp.zeros(model.node_count, dtype=wp.vec2d, device=d)   # this step's reactions [N/m]
         self._dt_work = 0.0                     # step length of the forces whose second half of work is pending [s]
         # (particle, element) contact histories, read from one pair and written to the other each step
@@ -150,7 +152,7 @@ class GasRockCoupler:
         self._since += 1
         mpm, m = self.mpm, self.model
         self._account_work(state, self._dt_work)          # the last step's forces, velocities after that step
-        wp.launch(_reset_step_acc, dim=1, inputs=[], outputs=[self.acc], device=m.device)
+        self._launch(_reset_step_acc, dim=1, inputs=[], outputs=[self.acc], device=m.device)
         self.f_react.zero_()
         self._dt_work = dt
         if self.n_exposed == 0:
@@ -158,7 +160,7 @@ class GasRockCoupler:
             mpm.f_ext_moment.zero_()
             self._hist[0][0].fill_(-1)
             return
-        wp.launch(eval_particle_edge_contact, dim=mpm.n,
+        self._launch(eval_particle_edge_contact, dim=mpm.n,
                   inputs=[self.grid.id, self.elems, self.points, self.elem_reach, self.slot_iface, state.pair_mode, state.x, state.v, m.node_mass,
                           mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p, mpm.rho, mpm.active,
                           wp.float64(self.kc), wp.float64(self.force_cap), wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
@@ -166,13 +168,13 @@ class GasRockCoupler:
                           wp.float64(float(self.surface_forces)), wp.float64(float(self.pressure_preload)),
                           *self._hist[0]],
                   outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1]],
-                  device=m.device)
+                  device=m.device, key=id(self._hist[0][0]))          # one record per history buffer
         self._hist.reverse()
         self._account_work(state, dt)                      # this step's forces, velocities before the step
 
     def add_reactions(self, state) -> None:
         """state.f += this step's contact reactions (f_react)."""
-        wp.launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_react], device=self.model.device)
+        self._launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_react], device=self.model.device)
 
     def _account_work(self, state, dt: float) -> None:
         """Add ½dt of the work of the current contact forces to the absorbed energy, with the present velocities.
@@ -187,9 +189,9 @@ class GasRockCoupler:
             return
         mpm, d = self.mpm, self.model.device
         w = wp.float64(0.5 * dt)
-        wp.launch(accumulate_gas_contact_work, dim=mpm.n,
+        self._launch(accumulate_gas_contact_work, dim=mpm.n,
                   inputs=[mpm.f_ext_p, mpm.f_ext_moment, mpm.v_pic, mpm.grad_v, mpm.active, w], outputs=[self.acc], device=d)
-        wp.launch(accumulate_rock_contact_work, dim=self.model.node_count, inputs=[self.f_react, state.v, w],
+        self._launch(accumulate_rock_contact_work, dim=self.model.node_count, inputs=[self.f_react, state.v, w],
                   outputs=[self.acc], device=d)
 
     def energies(self) -> dict[str, float]:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
-from blastfrac._warp import resolve_device
+from blastfrac._warp import Launcher, resolve_device
 from blastfrac.materials.cj import cj_state
 from blastfrac.materials.jwl import JWLParams, jwl_sound_speed_sq_np
 from blastfrac.materials.linear_elastic_mp import LinearElasticMP, strain_energy_density_np
@@ -268,6 +268,7 @@ class MPMSolver:
     def _build(self, x, vol, spec: GridSpec, material, opts: MPMOptions, device, v=None, light_time=None, burn=None,
                body_id=None, bodies=()):
         self.device = resolve_device(device)
+        self._launch = Launcher()                 # recorded launches of the per-step stages (_warp.Launcher)
         self.spec, self.material, self.opts = spec, material, opts
         self.is_jwl = isinstance(material, JWLParams)
         x = np.ascontiguousarray(x, dtype=F64).reshape(-1, 2)
@@ -451,9 +452,9 @@ class MPMSolver:
     def to_grid(self, dt: float) -> None:
         """P2G (mass, momentum, forces incl. f_ext_p) at the current positions."""
         g = self.grid
-        wp.launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 1], outputs=[g.mass, g.mom, g.force],
-                  device=self.device)
-        wp.launch(
+        self._launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 1],
+                     outputs=[g.mass, g.mom, g.force], device=self.device, key="p2g")
+        self._launch(
             p2g,
             dim=self.n,
             inputs=[self.x, self.v, self.b_aff, self.mass, self.vol, self.stress, self.f_ext_p, self.f_ext_moment, self.active,
@@ -466,7 +467,7 @@ class MPMSolver:
     def update_grid(self, dt: float) -> None:
         """Integrate node momenta over dt [s] with the mass cut-off and boundary conditions."""
         g = self.grid
-        wp.launch(
+        self._launch(
             update_grid_momentum,
             dim=g.box_node_count,
             inputs=[*g.box_args(), g.mass, g.bc_mask, g.bc_vel, g.force, F64(dt), F64(self.m_cut)],
@@ -479,27 +480,28 @@ class MPMSolver:
         """Image walls: fold the ghosts' P2G sums onto their images, x walls then y walls."""
         g = self.grid
         for a in g.mirror_axes:
-            wp.launch(fold_wall_images, dim=g.box_node_count,
-                      inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], with_mass_force],
-                      outputs=[g.mass, g.mom, g.force], device=self.device)
+            self._launch(fold_wall_images, dim=g.box_node_count,
+                         inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], with_mass_force],
+                         outputs=[g.mass, g.mom, g.force], device=self.device, key=a)
 
     def _wall_ghosts(self, with_dvel: int) -> None:
         """Image walls: ghosts take their images' velocities, x walls then y walls."""
         g = self.grid
         for a in g.mirror_axes:
-            wp.launch(set_wall_ghosts, dim=g.box_node_count,
-                      inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], g.mass, with_dvel],
-                      outputs=[g.vel, g.dvel, g.mom], device=self.device)
+            self._launch(set_wall_ghosts, dim=g.box_node_count,
+                         inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], g.mass, with_dvel],
+                         outputs=[g.vel, g.dvel, g.mom], device=self.device, key=a)
 
     def to_particles(self, dt: float) -> None:
         """G2P (FLIP/PIC or APIC), MUSL remap (with the affine term), velocity gradient, volume and position update."""
         g, geo, d = self.grid, self._geo_f(), self.device
         if self.apic:
             v_max = self.opts.v_max if self.is_jwl else float("inf")
-            wp.launch(g2p_velocity_apic, dim=self.n, inputs=[self.x, self.active, g.vel, *geo, self.vol, self.vol0, F64(v_max)],
-                      outputs=[self.v, self.v_pic, self.b_aff], device=d)
+            self._launch(g2p_velocity_apic, dim=self.n,
+                         inputs=[self.x, self.active, g.vel, *geo, self.vol, self.vol0, F64(v_max)],
+                         outputs=[self.v, self.v_pic, self.b_aff], device=d)
         else:
-            wp.launch(
+            self._launch(
                 g2p_velocity,
                 dim=self.n,
                 inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip),
@@ -507,12 +509,12 @@ class MPMSolver:
                 outputs=[self.v, self.v_pic, self.ie],
                 device=d,
             )
-        wp.launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 0], outputs=[g.mass, g.mom, g.force],
-                  device=d)
-        wp.launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo],
-                  outputs=[g.mom], device=d)
+        self._launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 0],
+                     outputs=[g.mass, g.mom, g.force], device=d, key="remap")
+        self._launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo],
+                     outputs=[g.mom], device=d)
         self._fold_walls(0)
-        wp.launch(
+        self._launch(
             velocity_from_momentum,
             dim=g.box_node_count,
             inputs=[*g.box_args(), g.mass, g.bc_mask, g.bc_vel, g.mom, F64(self.m_cut)],
@@ -520,7 +522,7 @@ class MPMSolver:
             device=d,
         )
         self._wall_ghosts(0)
-        wp.launch(
+        self._launch(
             update_particle_kinematics,
             dim=self.n,
             inputs=[self.active, self.mass, g.vel, self.v_pic, *geo, F64(dt)],
@@ -536,7 +538,7 @@ class MPMSolver:
         kernel skips the points of the other kind)."""
         d = self.device
         if self.n_solid:
-            wp.launch(
+            self._launch(
                 update_elastic_state,
                 dim=self.n,
                 inputs=[self.active, self.mat_kind, self.grad_v, self.rho, self.vol_prev, self.vol, self.lam, self.mu,
@@ -547,7 +549,7 @@ class MPMSolver:
         if not self.is_jwl:
             return
         P, o = self.material, self.opts
-        wp.launch(
+        self._launch(
             update_burn,
             dim=self.n,
             inputs=[self.active, self.mat_kind, self.light_time, self.vol, self.vol0, F64(t + dt), F64(P.D), F64(P.rho0), F64(self.p_cj),
@@ -555,7 +557,7 @@ class MPMSolver:
             outputs=[self.burn],
             device=d,
         )
-        wp.launch(
+        self._launch(
             update_jwl_state,
             dim=self.n,
             inputs=[self.active, self.mat_kind, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v, self.burn,
@@ -580,7 +582,8 @@ class MPMSolver:
     def stable_dt(self) -> float:
         """alpha h / max(c + |v|) over active particles [s] (inf if none)."""
         self._smax.zero_()
-        wp.launch(max_signal_speed, dim=self.n, inputs=[self.active, self.v, self.cs], outputs=[self._smax], device=self.device)
+        self._launch(max_signal_speed, dim=self.n, inputs=[self.active, self.v, self.cs], outputs=[self._smax],
+                     device=self.device)
         s = float(self._smax.numpy()[0])
         return self.opts.cfl * self.spec.h / s if s > 0 else float("inf")
 
