@@ -105,6 +105,39 @@ def run_case(name: str, device: str = "cpu", steps: int = 100) -> dict:
             "launches_per_step": cracked["launches_per_step"], "broken_springs": s["broken_springs"]["total"]}
 
 
+def fixed_cost(device: str = "cpu", steps: int = 400) -> dict:
+    """The size-independent cost of a coupled step (issue 14 item 1): the demo's step on a 56-element, 20-point
+    version of it (4 cm disc, 1 cm mesh, 2 mm cells, one point per cell), against the demo's own step, both over
+    the ``steps`` steps after the first 50 (process CPU time: the launches run in this thread)."""
+    import tomllib
+
+    from blastfrac.scenario import scenario_from_dict
+    from blastfrac.simulation import Simulation
+
+    base = tomllib.loads((ROOT / CASES["demo"][0]).read_text())
+    base["output"].update(paraview=False, figures=False)
+    base["simulation"]["progress"] = False
+    tiny = json.loads(json.dumps(base))
+    tiny["monitors"][0]["position"] = [0.01, 0.0]
+    tiny["zones"] = tiny["zones"][:2]
+    tiny["geometry"].update(domain={"type": "disc", "radius": 0.02}, mesh_size=0.01, mesh_size_near=0.004,
+                            refinement_distance=0.01)
+    tiny["explosive"]["grid"].update(cell_size=0.002, points_per_cell=1, bounds=[[-0.03, -0.03], [0.03, 0.03]])
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, d in (("tiny", tiny), ("demo", base)):
+            sim = Simulation(scenario_from_dict(d), out_dir=tmp, device=device)
+            for _ in range(50):
+                sim.step()
+            c0 = time.process_time()
+            for _ in range(steps):
+                sim.step()
+            out[name + "_ms"] = (time.process_time() - c0) / steps * 1e3
+            out[name + "_size"] = (sim.model.element_count, sim.gas.n)
+    out["fraction"] = out["tiny_ms"] / out["demo_ms"]
+    return out
+
+
 def one_core_wall(name: str, device: str = "cpu") -> float | None:
     """Run-loop wall time of a case pinned to one core (taskset), in a subprocess; None without taskset."""
     if shutil.which("taskset") is None:

@@ -74,6 +74,9 @@ def run(args) -> int:
             rows.append(r)
         print(f"Coupled step on {device} (outputs off)")
         print(cp.markdown(rows))
+        fx = cp.fixed_cost(device)
+        print(f"\nFixed cost of a step (the demo's step on {fx['tiny_size'][0]} elements and {fx['tiny_size'][1]} points): "
+              f"{fx['tiny_ms']:.3f} ms, {100 * fx['fraction']:.0f} % of the demo's first steps ({fx['demo_ms']:.3f} ms)")
     if args.reference:
         cp = _load("bench_coupled")
         from pathlib import Path as _P
