@@ -65,6 +65,10 @@ class Simulation:
         from .analysis.ppv import PeakVelocity
 
         self.ppv = PeakVelocity(self.model.node_count, self.device)      # peak particle velocity per node
+        self._rock_after = lambda: self.ppv.update(self.state.v)       # the end of a rock step (one object: a graph key)
+        # rock-only steps (no gas, or gas frozen) are replayed from a captured graph where they can be
+        # (CDEMSolver.step_captured: bit-identical; False runs every step through the launches)
+        self.use_graph = True
         self.gas_report: dict = {}
         self.charge_mirror = 1.0        # whole charge over modelled charge (half and quarter models)
         if scenario.explosive is not None:
@@ -190,8 +194,10 @@ class Simulation:
         dt = self.dt
         st = self.state
         couple = gas and self.gas is not None
-        self.cdem.forces_springs(st, dt, self.time)        # springs + failure (sets this step's pair_mode)
-        if couple:
+        if not couple and self.use_graph and self.cdem.step_captured(st, dt, self.time, self.alpha, self._rock_after):
+            pass                                           # the rock step below, replayed from a captured graph
+        elif couple:
+            self.cdem.forces_springs(st, dt, self.time)    # springs + failure (sets this step's pair_mode)
             self._concurrently(lambda: self.cdem.forces_rest(st, dt, self.time), lambda: self._gas_forces(dt))
             self.coupler.add_reactions(st)                 # the gas loads on the rock, in a fixed order
             if self.crack_gas is not None:
@@ -199,9 +205,10 @@ class Simulation:
             self._concurrently(lambda: (self.cdem.integrate(st, dt, self.alpha), self.ppv.update(st.v)),
                                lambda: self._gas_advance(dt))
         else:
+            self.cdem.forces_springs(st, dt, self.time)    # springs + failure
             self.cdem.forces_rest(st, dt, self.time)       # CST, loads, block contact
             self.cdem.integrate(st, dt, self.alpha)        # central difference on rock nodes
-            self.ppv.update(st.v)                          # PPV: max |v| per node
+            self._rock_after()                             # PPV: max |v| per node
         self.time += dt
         self.steps += 1
         if couple and self.steps % 10 == 0:

@@ -52,7 +52,7 @@ def eval_spring_forces(
     node_mass: wp.array(dtype=wp.float64),
     zeta: wp.float64,
     dt: wp.float64,
-    time: wp.float64,
+    clock: wp.array(dtype=wp.float64),
     pair_force: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
@@ -112,7 +112,7 @@ def eval_spring_forces(
             pair_work[k] = w
             if new_mode != 0:
                 pair_mode[k] = new_mode
-                pair_tbreak[k] = time
+                pair_tbreak[k] = clock[0]
                 pair_efrac[k] = w - stored_spring_energy(fn, fs, kn, ks)
         else:
             nn = nb
@@ -141,7 +141,8 @@ def eval_spring_forces(
         pair_force[k] = fv
 
 
-def launch_spring_forces(model, state, dt: float, time: float, launch=wp.launch) -> None:
+def launch_spring_forces(model, state, dt: float, clock: wp.array, launch=wp.launch) -> None:
+    """clock: [1] the time at the start of the step [s], on the device (a captured step advances it there)."""
     if model.interface_count == 0:
         return
     launch(
@@ -153,7 +154,7 @@ def launch_spring_forces(model, state, dt: float, time: float, launch=wp.launch)
                 wp.float64(model.tan_phi), wp.float64(model.tan_phi_r), wp.float64(model.slope_t),
                 wp.float64(model.slope_c), model.pair_law, wp.int32(model.per_pair_law),
                 wp.int32(model.breakable), model.node_mass,
-                wp.float64(model.spring_damping), wp.float64(dt), wp.float64(time)],
+                wp.float64(model.spring_damping), wp.float64(dt), clock],
         outputs=[state.pair_force, state.energy_acc],
         device=model.device,
     )

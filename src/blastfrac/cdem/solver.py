@@ -25,14 +25,29 @@ class CDEMSolver:
         self.contact = BlockContact(model) if use_contact else None
         self.dt_prev = 0.0
         self.launch = Launcher()                  # recorded launches of the rock stages (_warp.Launcher)
+        self.clock = wp.zeros(1, dtype=wp.float64, device=model.device)   # time at the start of the step [s]
+        self._clock_host = self.clock.numpy() if model.device == "cpu" else None
+        # Captured rock step (step_captured): None, or (key, graph); graph_steps counts its replays
+        self._graph = None
+        self.graph_steps = 0
+
+    def _set_clock(self, t: float) -> None:
+        if self._clock_host is not None:
+            self._clock_host[0] = t                 # a view of the CPU array: no launch
+        else:
+            self.clock.fill_(t)
+
+    def eval_pulses(self, t: float) -> None:
+        """Evaluate every pressure pulse at time t [s] into the host buffer that set_pulses copies."""
+        host = self._pulse_host.numpy()
+        for i, p in enumerate(self.model.pulses):
+            host[i] = p(t)
 
     def set_pulses(self, state: State, t: float) -> None:
         """Evaluate every pressure pulse at time t [s] and copy the values to the device."""
         if not self.model.pulses:
             return
-        host = self._pulse_host.numpy()
-        for i, p in enumerate(self.model.pulses):
-            host[i] = p(t)
+        self.eval_pulses(t)
         wp.copy(state.pulse_values, self._pulse_host)
 
     def forces(self, state: State, dt: float, t: float) -> None:
@@ -42,7 +57,8 @@ class CDEMSolver:
 
     def forces_springs(self, state: State, dt: float, t: float) -> None:
         """3a: springs, failure, broken-pair contact (after it, pair_mode holds this step's failures)."""
-        launch_spring_forces(self.model, state, dt, t, self.launch)
+        self._set_clock(t)
+        launch_spring_forces(self.model, state, dt, self.clock, self.launch)
 
     def forces_rest(self, state: State, dt: float, t: float) -> None:
         """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode)."""
@@ -57,6 +73,41 @@ class CDEMSolver:
         """Stage 4: central difference with damping, constraints and dashpots."""
         launch_integrate(self.model, state, dt, alpha, self.launch)
         self.dt_prev = dt
+
+    # ------------------------------------------------------------------ captured rock step
+    def step_captured(self, state: State, dt: float, t: float, alpha: float, after=None) -> bool:
+        """One rock step (stages 3 and 4, then ``after()``, e.g. the PPV update) replayed from a captured graph
+        (``wp.capture_begin``: a CUDA graph on a GPU, Warp's C++ replay of the recorded operations on a CPU); the
+        clock (a device array the springs read) and the pulses are set before each replay. The same kernels on
+        the same arrays as ``forces`` + ``integrate``, so the same results to the bit
+        (tests/unit/test_rock_graph.py). Returns False, having done nothing, where a graph cannot stand for the
+        step: block contact active (its pass sizes its launches from counts read back every step), the step not
+        yet repeating (dt_prev ≠ dt), or pulses on a GPU (their host buffer is rewritten before an asynchronous
+        replay has read it). The graph is captured again whenever a scalar it holds (dt, alpha, breakable), the
+        state or ``after`` changes."""
+        m = self.model
+        if (self.contact is not None and self.contact.active) or self.dt_prev != dt or \
+                (m.pulses and m.device != "cpu"):
+            return False
+        key = (id(state), dt, alpha, m.breakable, after)
+        if self._graph is None or self._graph[0] != key:
+            self._set_clock(t)
+            wp.capture_begin(device=m.device)
+            try:
+                launch_spring_forces(m, state, dt, self.clock, self.launch)
+                self.forces_rest(state, dt, t)
+                self.integrate(state, dt, alpha)
+                if after is not None:
+                    after()
+            finally:
+                graph = wp.capture_end(device=m.device)
+            self._graph = (key, graph)
+        self._set_clock(t)                           # the graph's springs read the clock when it runs
+        if m.pulses:
+            self.eval_pulses(t)                      # and its copy this buffer
+        wp.capture_launch(self._graph[1])
+        self.graph_steps += 1
+        return True
 
     def initialise_stress(self, state: State, sxx: float, syy: float, sxy: float) -> None:
         """Uniform initial stress σ⁰ in all blocks and consistent spring forces (METHOD §1.8)."""
