@@ -8,6 +8,7 @@ progress bar and a NaN guard. The in-situ stress stage, when asked for, runs fir
 from __future__ import annotations
 
 import math
+import os
 import sys
 import time as _time
 from pathlib import Path
@@ -75,7 +76,8 @@ class Simulation:
             self._build_explosive()
         self.dt = self._time_step()
         self._pool = None
-        if scenario.simulation.threads > 1 and self.gas is not None:
+        if scenario.simulation.threads > 1 and self.gas is not None and self.device == "cpu" and \
+                (os.cpu_count() or 1) > 1:
             from concurrent.futures import ThreadPoolExecutor
 
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="blastfrac-gas")

@@ -127,8 +127,9 @@ def validate_cases(sweep: Sweep) -> None:
 
 
 # ----------------------------------------------------------------------------- one case (runs on a worker)
-def run_case(scenario: str, overrides: list[str], out_dir: str) -> dict:
-    """Run one case in this process; returns its summary (or {'status': 'failed', 'error': ...})."""
+def run_case(scenario: str, overrides: list[str], out_dir: str, threads: int | None = None) -> dict:
+    """Run one case in this process; returns its summary (or {'status': 'failed', 'error': ...}). ``threads``, if
+    given, sets simulation.threads (a sweep of several workers runs each case on one thread)."""
     from .scenario import load_scenario
     from .scenario.load import resolved_dict
     from .simulation import Simulation
@@ -138,6 +139,8 @@ def run_case(scenario: str, overrides: list[str], out_dir: str) -> dict:
         sc = load_scenario(scenario, overrides)
         sc.output.directory = out_dir
         sc.simulation.progress = False
+        if threads is not None:
+            sc.simulation.threads = threads
         done = _finished(Path(out_dir), resolved_dict(sc))
         if done is not None:
             done["skipped"] = True
@@ -178,16 +181,18 @@ def run_sweep(sweep: Sweep | str | Path, scheduler: str | None = None, workers: 
     sweep.output.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     cluster = None
+    threads = 1                                  # the cases fill the cores: one thread each
     if scheduler:
         client = Client(scheduler)
     else:
         n = workers or os.cpu_count() or 1
+        threads = None if n == 1 else 1
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None)
         client = Client(cluster)
     results: dict[str, dict] = {}
     try:
-        futures = {client.submit(run_case, str(c.scenario), c.override_strings(), str(c.out_dir), key=f"case-{c.name}",
-                                 pure=False): c for c in sweep.cases}
+        futures = {client.submit(run_case, str(c.scenario), c.override_strings(), str(c.out_dir), threads,
+                                 key=f"case-{c.name}", pure=False): c for c in sweep.cases}
         bar = _SweepProgress(len(futures), progress)
         for fut in as_completed(futures):
             c = futures[fut]
