@@ -12,9 +12,9 @@ broken springs can carry them into a block they are not paired with. An open fac
 such a block "wakes" it for ``near_window`` steps, and its held nodes search the hash too, so they cannot
 enter the open block unseen either: an open node wakes the blocks whose edges not at its vertex are within
 h_min of it (hash) and the blocks of its fan whose other two nodes are within h_min of its own element's
-edges at the vertex (``fan_wake``); an edge that merely ends at the node's vertex touches it there and wakes
-nothing (it did before, which kept every open node of a cracked face searching the hash at every step and
-its fan woken). Running over all nodes gives both passes (A→B and B→A).
+edges at the vertex (``held_search`` with ``wake``); an edge that merely ends at the node's vertex touches
+it there and wakes nothing (it did before, which kept every open node of a cracked face searching the hash at
+every step and its fan woken). Running over all nodes gives both passes (A→B and B→A).
 
 **Geometry.** Node x against edge a→b of length L: ξ = (x − x_a)·t̂/L and g = (x − x_a)·n̂ [m],
 with n̂ = (t_y, −t_x) the outward normal of a counter-clockwise element (TriMesh orients them so).

@@ -122,70 +122,6 @@ def fan_cache_build(
 
 
 @wp.func
-def held_search(
-    n: wp.int32,
-    excl: wp.int64,
-    use_cache: wp.int32,
-    node_vertex: wp.array(dtype=wp.int32),
-    vertex_start: wp.array(dtype=wp.int32),
-    vertex_nodes: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
-    pair_mode: wp.array(dtype=wp.int32),
-    x: wp.array(dtype=wp.vec2d),
-    max_depth: wp.float64,
-    touch_tol: wp.float64,
-    fan_cand: wp.array2d(dtype=wp.int32),
-    fan_count: wp.array(dtype=wp.int32),
-):
-    """Search state (consider_edge) of held node n: the other blocks at its own vertex only (module doc). With
-    use_cache, over its cached fan candidates (fan_cache_build: the same nodes in the same order, so the same
-    result); otherwise, or if the fan overflowed the cache, by walking the vertex's node list."""
-    e = n // 3
-    zero = wp.float64(0.0)
-    xn = x[n]
-    st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
-    # the node's element wedge (unit vectors along its two edges at the node), only once a corner test passes
-    have_u = bool(False)
-    u1 = wp.vec2d(zero, zero)
-    u2 = wp.vec2d(zero, zero)
-    cnt = wp.int32(-1)
-    if use_cache != 0:
-        cnt = fan_count[n]
-    if cnt >= 0:
-        for k in range(cnt):
-            code = fan_cand[n, k]
-            other = code >> 2
-            ex1 = (code & 1) != 0
-            ex2 = (code & 2) != 0
-            if corner_inside(xn, other, ex1, ex2, x, touch_tol):
-                if not have_u:
-                    u1 = wp.normalize(x[slot_end(n)] - xn)
-                    u2 = wp.normalize(x[slot_prev(n)] - xn)
-                    have_u = True
-                st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st, max_depth, touch_tol)
-    else:
-        vtx = node_vertex[n]
-        for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
-            other = vertex_nodes[j]
-            if other // 3 != e:
-                if not in_mask(excl, other, fan_index):
-                    ex1 = slot_exposed(other, slot_iface, pair_mode)
-                    ex2 = slot_exposed(slot_prev(other), slot_iface, pair_mode)
-                    # only a node inside the corner (behind both exposed edges) can be a contact: a cheap sign
-                    # test first, the full evaluation for the few that pass
-                    if ex1 or ex2:
-                        if corner_inside(xn, other, ex1, ex2, x, touch_tol):
-                            if not have_u:
-                                u1 = wp.normalize(x[slot_end(n)] - xn)
-                                u2 = wp.normalize(x[slot_prev(n)] - xn)
-                                have_u = True
-                            st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st,
-                                                 max_depth, touch_tol)
-    return st
-
-
-@wp.func
 def point_segment_distance(p: wp.vec2d, a: wp.vec2d, b: wp.vec2d):
     """Distance from point p to the segment a–b [m]."""
     ab = b - a
@@ -210,7 +146,7 @@ def far_nodes_near(other: wp.int32, xa: wp.vec2d, xn: wp.vec2d, xb: wp.vec2d, x:
 
 
 @wp.func
-def fan_wake(
+def held_search(
     n: wp.int32,
     excl: wp.int64,
     use_cache: wp.int32,
@@ -221,38 +157,74 @@ def fan_wake(
     slot_iface: wp.array(dtype=wp.int32),
     pair_mode: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
+    max_depth: wp.float64,
+    touch_tol: wp.float64,
     fan_cand: wp.array2d(dtype=wp.int32),
     fan_count: wp.array(dtype=wp.int32),
+    wake: bool,
     wake_dist: wp.float64,
     step: wp.int32,
     elem_near: wp.array(dtype=wp.int32),
 ):
-    """Wake (elem_near) the blocks of open node n's fan candidates whose other nodes come within wake_dist of n's
-    element edges at the vertex: those nodes could enter n's block through an edge that is not at their own
-    vertex, which their fan search does not see (cdem/contact.py, "Cost"). The edges that end at the vertex
-    itself touch n there and say nothing about that, so they do not wake a block."""
+    """Search state (consider_edge) of node n against the other blocks at its own vertex only (module doc): all
+    a held node searches, and the edges at its vertex for an open one. With use_cache, over its cached fan
+    candidates (fan_cache_build: the same nodes in the same order, so the same result); otherwise, or if the fan
+    overflowed the cache, by walking the vertex's node list.
+
+    With ``wake`` (an open node) it also wakes (elem_near) the blocks of the fan whose other two nodes come
+    within wake_dist of n's element edges at the vertex: those nodes could enter n's block through an edge that
+    is not at their own vertex, which their fan search does not see (cdem/contact.py, "Cost"). The edges that
+    end at the vertex itself touch n there and say nothing about that, so they wake no block."""
+    e = n // 3
+    zero = wp.float64(0.0)
     xn = x[n]
     xa = x[slot_prev(n)]
     xb = x[slot_end(n)]
+    st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
+    # the node's element wedge (unit vectors along its two edges at the node), only once a corner test passes
+    have_u = bool(False)
+    u1 = wp.vec2d(zero, zero)
+    u2 = wp.vec2d(zero, zero)
     cnt = wp.int32(-1)
     if use_cache != 0:
         cnt = fan_count[n]
     if cnt >= 0:
         for k in range(cnt):
-            other = fan_cand[n, k] >> 2
-            if far_nodes_near(other, xa, xn, xb, x, wake_dist):
-                elem_near[other // 3] = step
+            code = fan_cand[n, k]
+            other = code >> 2
+            ex1 = (code & 1) != 0
+            ex2 = (code & 2) != 0
+            if wake:
+                if far_nodes_near(other, xa, xn, xb, x, wake_dist):
+                    elem_near[other // 3] = step
+            if corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                if not have_u:
+                    u1 = wp.normalize(x[slot_end(n)] - xn)
+                    u2 = wp.normalize(x[slot_prev(n)] - xn)
+                    have_u = True
+                st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st, max_depth, touch_tol)
     else:
-        e = n // 3
         vtx = node_vertex[n]
         for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
             other = vertex_nodes[j]
             if other // 3 != e:
                 if not in_mask(excl, other, fan_index):
-                    if slot_exposed(other, slot_iface, pair_mode) or slot_exposed(slot_prev(other), slot_iface,
-                                                                                  pair_mode):
+                    ex1 = slot_exposed(other, slot_iface, pair_mode)
+                    ex2 = slot_exposed(slot_prev(other), slot_iface, pair_mode)
+                    # only a node inside the corner (behind both exposed edges) can be a contact: a cheap sign
+                    # test first, the full evaluation for the few that pass
+                    if wake and (ex1 or ex2):
                         if far_nodes_near(other, xa, xn, xb, x, wake_dist):
                             elem_near[other // 3] = step
+                    if ex1 or ex2:
+                        if corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                            if not have_u:
+                                u1 = wp.normalize(x[slot_end(n)] - xn)
+                                u2 = wp.normalize(x[slot_prev(n)] - xn)
+                                have_u = True
+                            st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st,
+                                                 max_depth, touch_tol)
+    return st
 
 
 @wp.kernel
@@ -417,7 +389,7 @@ def select_contact_nodes(
         return
     is_open = flag == 2
     woken = node_woken(n // 3, elem_near, step, near_window)
-    # open nodes are listed whenever they have a fan (its search and fan_wake run every step), the hash search
+    # open nodes are listed whenever they have a fan (its search and wake run every step), the hash search
     # when due
     if not (is_open or woken):
         if contact_slot[n] < 0:

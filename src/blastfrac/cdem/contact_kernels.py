@@ -6,7 +6,7 @@ from __future__ import annotations
 import warp as wp
 
 from ..model.model import CONTACT_DISSIPATED
-from .contact_fan import fan_wake, held_search, node_faces, node_woken
+from .contact_fan import held_search, node_faces, node_woken
 from .contact_geometry import (
     KC_CAP,
     LOSS_PENALTY,
@@ -245,9 +245,7 @@ def eval_block_contact(
         # the edges at its own vertex from its fan (as a held node), every step; the others through the hash,
         # unless it is quiet (its last search saw no such edge within wake_dist, BlockContact doc)
         st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,
-                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count)
-        fan_wake(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface, pair_mode, x,
-                 fan_cand, fan_count, wake_dist, step, elem_near)
+                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count, True, wake_dist, step, elem_near)
         if woken or step >= query_after[n] or contact_slot[n] >= 0:
             st = hash_search(n, True, True, st, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim,
                              cell_starts, cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index,
@@ -263,7 +261,7 @@ def eval_block_contact(
     elif held_faces != 0:
         # broken faces still held by their springs, not woken: only the other blocks at the node's vertex
         st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,
-                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count)
+                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count, False, wake_dist, step, elem_near)
         # nothing found and no contact to end: contact_force would only rewrite the zeros of a node without one
         if st[0] < zero and contact_slot[n] < 0:
             return
