@@ -10,6 +10,7 @@ import functools
 import os
 import re
 import sys
+import threading
 
 import warp as wp
 
@@ -57,6 +58,10 @@ def resolve_device(name: str | None) -> str:
                              f"(cuda:0..cuda:{count - 1})")
         return f"cuda:{int(m.group(2))}"
     return "cuda:0"
+
+
+#: recording a launch may load its module, which Warp does not guard against two threads (it crashed the process)
+_RECORD_LOCK = threading.Lock()
 
 
 class Launcher:
@@ -114,7 +119,8 @@ class Launcher:
                 cmd.launch()
                 self.replays += 1
                 return
-        cmd = wp.launch(kernel, dim=dim, inputs=params, device=device, record_cmd=True)
+        with _RECORD_LOCK:                           # a first launch loads the kernel's module: one thread at a time
+            cmd = wp.launch(kernel, dim=dim, inputs=params, device=device, record_cmd=True)
         self._cmds[(kernel, key)] = [cmd, params, dim, any(hasattr(a, "_cls") for a in params)]
         self.records += 1
         cmd.launch()

@@ -81,6 +81,7 @@ class Simulation:
             from concurrent.futures import ThreadPoolExecutor
 
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="blastfrac-gas")
+            self.cdem.pool = self._pool                    # the springs in two halves (CDEMSolver.forces_springs)
         self.time = 0.0
         self.steps = 0
         self.alpha = scenario.simulation.damping
@@ -234,8 +235,9 @@ class Simulation:
         self.gas.update_eos(dt, self.time)                 # burn, viscosity, JWL
 
     def _concurrently(self, rock, gas) -> None:
-        """Run the two stage groups, in the second thread when simulation.threads = 2."""
-        if self._pool is None:
+        """Run the two stage groups, in the second thread when simulation.threads = 2 (from the second step on: the
+        first loads every kernel's module, which Warp does not guard against two threads)."""
+        if self._pool is None or self.steps == 0:
             rock()
             gas()
             return

@@ -53,6 +53,7 @@ def eval_spring_forces(
     zeta: wp.float64,
     dt: wp.float64,
     clock: wp.array(dtype=wp.float64),
+    first: wp.int32,
     pair_force: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
@@ -64,8 +65,11 @@ def eval_spring_forces(
 
     With per_pair_law = 1 (a model with joints) each spring takes its friction and softening
     (tanφ, tanφ_r, slope_t, slope_c) from pair_law; otherwise every spring takes the scalars.
+
+    Thread i updates interface first + i (a launch may cover part of the interfaces: two threads, each with its
+    own energy_acc, see CDEMSolver.forces_springs).
     """
-    q = wp.tid()
+    q = wp.tid() + first
     half = wp.float64(0.5)
     pa = 2 * q
     pb = 2 * q + 1
@@ -141,20 +145,25 @@ def eval_spring_forces(
         pair_force[k] = fv
 
 
-def launch_spring_forces(model, state, dt: float, clock: wp.array, launch=wp.launch) -> None:
-    """clock: [1] the time at the start of the step [s], on the device (a captured step advances it there)."""
-    if model.interface_count == 0:
+def launch_spring_forces(model, state, dt: float, clock: wp.array, launch=wp.launch, first: int = 0,
+                         count: int | None = None, energy_acc: wp.array | None = None, key=None) -> None:
+    """Interfaces first … first + count − 1 (all by default). clock: [1] the time at the start of the step [s], on
+    the device (set before the step, and before each replay of a captured one); energy_acc: where the dashpots'
+    work goes (state.energy_acc by default)."""
+    count = model.interface_count - first if count is None else count
+    if count <= 0:
         return
+    site = {} if key is None else {"key": key}        # a Launcher's call site (the plain wp.launch has none)
     launch(
         eval_spring_forces,
-        dim=model.interface_count,
+        dim=count,
         inputs=[model.pair_i, model.pair_j, model.pair_kn, model.pair_ks, model.pair_ac, model.pair_l0,
                 state.x, state.v, state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped,
                 state.pair_g0, state.pair_tbreak, state.pair_work, state.pair_efrac,
                 wp.float64(model.tan_phi), wp.float64(model.tan_phi_r), wp.float64(model.slope_t),
                 wp.float64(model.slope_c), model.pair_law, wp.int32(model.per_pair_law),
                 wp.int32(model.breakable), model.node_mass,
-                wp.float64(model.spring_damping), wp.float64(dt), clock],
-        outputs=[state.pair_force, state.energy_acc],
-        device=model.device,
+                wp.float64(model.spring_damping), wp.float64(dt), clock, first],
+        outputs=[state.pair_force, state.energy_acc if energy_acc is None else energy_acc],
+        device=model.device, **site,
     )
