@@ -75,8 +75,9 @@ def run(args) -> int:
         print(f"Coupled step on {device} (outputs off)")
         print(cp.markdown(rows))
         fx = cp.fixed_cost(device)
-        print(f"\nFixed cost of a step (the demo's step on {fx['tiny_size'][0]} elements and {fx['tiny_size'][1]} points): "
-              f"{fx['tiny_ms']:.3f} ms, {100 * fx['fraction']:.0f} % of the demo's first steps ({fx['demo_ms']:.3f} ms)")
+        print(f"\nFixed cost of a step (the demo's step on {fx['tiny_size'][0]} elements and {fx['tiny_size'][1]} points, "
+              f"one thread): {fx['tiny_ms']:.3f} ms, {100 * fx['fraction']:.0f} % of the demo's first steps "
+              f"({fx['demo_ms']:.3f} ms); with two threads {fx['tiny_2threads_ms']:.3f} ms (their hand-offs)")
     if args.reference:
         cp = _load("bench_coupled")
         from pathlib import Path as _P
