@@ -2,8 +2,8 @@
 
 Scatter with ``wp.atomic_add`` inside a single launch (safe on CPU and CUDA).
 Arguments: particle arrays, grid geometry scalars, then grid outputs (zeroed by the launcher).
-The momentum carries each particle's affine velocity C_p = B_p D_p^-1 (APIC, :mod:`blastfrac.mpm.apic`);
-with the FLIP/PIC transfer B_p stays 0 and the sums are bit for bit those without it.
+The momentum carries each particle's affine velocity C_p = B_p D_p^-1 (APIC, :mod:`blastfrac.mpm.apic`) when
+``affine`` is 1; with the FLIP/PIC transfer (``affine`` 0) B_p stays 0 and the term is skipped.
 """
 
 from __future__ import annotations
@@ -44,6 +44,7 @@ def p2g(
     py: int,
     kind: int,
     l: wp.float64,
+    affine: int,
     g_mass: wp.array(dtype=wp.float64),
     g_mom: wp.array(dtype=wp.vec2d),
     g_force: wp.array(dtype=wp.vec2d),
@@ -66,16 +67,21 @@ def p2g(
     h = F64(1.0) / inv_h
     fx = (x[p][0] - x0) * inv_h
     fy = (x[p][1] - y0) * inv_h
-    Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
+    Cp = wp.mat22d()
+    if affine != 0:
+        Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
     for i in range(3):
         ii = wrap_index(bx + i, nx, px)
         for j in range(3):
             n = wrap_index(by + j, ny, py) * nx + ii
             N = wx[i] * wy[j]
             grad = wp.vec2d(dwx[i] * wy[j] * inv_h, wx[i] * dwy[j] * inv_h)
-            dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
             wp.atomic_add(g_mass, n, N * m)
-            wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))
+            if affine != 0:
+                dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
+                wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))
+            else:
+                wp.atomic_add(g_mom, n, N * mv)
             wp.atomic_add(g_force, n, N * fe + ms * grad)
 
 
@@ -95,6 +101,7 @@ def p2g_momentum(
     py: int,
     kind: int,
     l: wp.float64,
+    affine: int,
     g_mom: wp.array(dtype=wp.vec2d),
 ):
     """MUSL remap: p_I = sum N m_p (v_p + C_p (x_I − x_p)), C_p = B_p D_p^-1, with the updated particle velocities
@@ -108,11 +115,16 @@ def p2g_momentum(
     h = F64(1.0) / inv_h
     fx = (x[p][0] - x0) * inv_h
     fy = (x[p][1] - y0) * inv_h
-    Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
+    Cp = wp.mat22d()
+    if affine != 0:
+        Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
     for i in range(3):
         ii = wrap_index(bx + i, nx, px)
         for j in range(3):
             n = wrap_index(by + j, ny, py) * nx + ii
             N = wx[i] * wy[j]
-            dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
-            wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))
+            if affine != 0:
+                dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
+                wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))
+            else:
+                wp.atomic_add(g_mom, n, N * mv)

@@ -458,7 +458,7 @@ class MPMSolver:
             p2g,
             dim=self.n,
             inputs=[self.x, self.v, self.b_aff, self.mass, self.vol, self.stress, self.f_ext_p, self.f_ext_moment, self.active,
-                    *self._geo_f()],
+                    *self._geo_f(), int(self.apic)],
             outputs=[g.mass, g.mom, g.force],
             device=self.device,
         )
@@ -511,7 +511,7 @@ class MPMSolver:
             )
         self._launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 0],
                      outputs=[g.mass, g.mom, g.force], device=d, key="remap")
-        self._launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo],
+        self._launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo, int(self.apic)],
                      outputs=[g.mom], device=d)
         self._fold_walls(0)
         self._launch(
