@@ -125,7 +125,7 @@ def run(scenario: str = "examples/circular_rock/demo.toml", steps: int = 200, ro
     from blastfrac.scenario.load import load_scenario
     from blastfrac.simulation import Simulation
 
-    sc = load_scenario(ROOT / scenario)
+    sc = load_scenario(ROOT / scenario, ["simulation.threads=1"])   # the rock step on one thread
     load0 = os.getloadavg()
     with tempfile.TemporaryDirectory() as tmp:
         cracked = Simulation(sc, out_dir=tmp, device=device)

@@ -95,8 +95,9 @@ end of the demo), so the pass works from caches that change only when a spring d
 - the hash is a cell grid of our own with the cells and the point order of wp.HashGrid (the same points met in the
   same order), each cell's points stored together with the exposure of their edge (kept by mark_pair_changes):
   a query reads memory in sequence and loads no spring state;
-- the launches are recorded once and replayed (``_warp.Launcher``): packing ~50 arguments costs more than a
-  pass over the nodes of a small mesh.
+- the kernels take their arrays as five Warp structs (``contact_data``: mesh, hash, caches, history, parameters)
+  and the rock state's arrays, and the launches are recorded once and replayed (``_warp.Launcher``): packing the
+  ~50 arrays of a launch cost more than a pass over the nodes of a small mesh.
 
 With ``fan_cache`` off every node is evaluated as before (wp.HashGrid, every held node walks its fan; ~15 %
 slower than the code before the cache, a reference only). Demo end state (3,966 blocks, 39.5 % of the springs
@@ -122,6 +123,7 @@ import numpy as np
 import warp as wp
 
 from .._warp import Launcher
+from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh, ContactParams
 from .contact_fan import (
     list_candidates,
     mark_pair_changes,
@@ -273,15 +275,44 @@ class BlockContact:
         self._cand_count = wp.zeros(1, dtype=wp.int32, device=d)
         self._n_cand = 0
         self._step = 0
-        # ~50 arguments a launch: packing them costs more than a pass over the nodes of a small mesh
-        self._launch = Launcher()
+        self._launch = Launcher()                 # recorded launches (packing costs more than a small mesh's pass)
+        self._structs()
+
+    def _structs(self) -> None:
+        """The kernels' arguments as Warp structs (contact_data): the same array objects as the attributes above."""
+        m = self.model
+        mesh = self.s_mesh = ContactMesh()
+        for k in ("slot_iface", "slot_l0", "node_vertex", "vertex_start", "vertex_nodes", "fan_index"):
+            setattr(mesh, k, getattr(self, k))
+        mesh.node_mass, mesh.node_pairs, mesh.pair_i, mesh.pair_j = m.node_mass, m.node_pairs, m.pair_i, m.pair_j
+        hsh = self.s_hash = ContactHash()
+        hsh.grid, hsh.points, hsh.sample_slot = self.grid.id, self.points, self.sample_slot
+        hsh.cell_inv, hsh.cell_dim = self.cell_inv, self.cell_dim
+        hsh.cell_starts, hsh.cell_ends, hsh.sorted_xy, hsh.sorted_code = (self.cell_starts, self.cell_ends,
+                                                                          self.sorted_xy, self.sorted_code)
+        cache = self.s_cache = ContactCache()
+        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "query_after"):
+            setattr(cache, k, getattr(self, k))
+        hist = self.s_hist = ContactHistory()
+        hist.slot, hist.fs, hist.d0, hist.p, hist.kc = (self.contact_slot, self.contact_fs, self.contact_d0,
+                                                        self.contact_p, self.contact_kc)
+        hist.loss_acc = self.loss_acc
+        self.s_prm = ContactParams()
+
+    def _params(self) -> ContactParams:
+        """The scheme's scalars as they are now (tests and benchmarks change held_faces and near_window)."""
+        prm = self.s_prm
+        prm.kn_area, prm.mu_f, prm.search_radius = self.kn_area, self.mu_f, self.radius
+        prm.max_depth, prm.touch_tol, prm.wake_dist = 0.5 * self.h_min, 1e-9 * self.h_min, self.h_min
+        prm.near_window, prm.quiet_steps = int(self.near_window), int(self.rebuild_interval)
+        prm.held_faces = int(bool(self.held_faces))
+        return prm
 
     def apply(self, state, dt: float) -> None:
         """Add the contact forces of the current configuration to state.f; dt [s] drives the friction."""
         if not self.active or self.kn_area == 0.0:
             return
         m = self.model
-        radius = self.radius
         use_cache = int(bool(self.fan_cache))
         # (a switch of fan_cache builds the other hash at once: only tests and benchmarks switch)
         rebuild = not self._built or use_cache != self._grid_kind
@@ -308,7 +339,7 @@ class BlockContact:
             else:
                 wp.launch(compute_edge_samples, dim=ns, inputs=[state.x, self.sample_slot, self.sample_frac],
                           outputs=[self.points], device=m.device)
-                self.grid.build(self.points, radius)
+                self.grid.build(self.points, self.radius)
             wp.copy(self._x_build, state.x)
             self._grid_kind = use_cache
             self._built = True
@@ -331,37 +362,29 @@ class BlockContact:
             dim = int(self._counts.numpy()[0]) if cpu and not refresh_all else self.vertex_count
             if dim:
                 self._launch(refresh_fan_cache, dim,
-                             [refresh_all, self._counts, self._dirty_vertices, self.node_vertex, self.vertex_start,
-                              self.vertex_nodes, self.fan_index, self.slot_iface, self.slot_l0, m.node_pairs,
-                              m.pair_i, m.pair_j, state.pair_mode, state.pair_dropped, self.node_face, self.node_flag,
-                              self.fan_excl, self.fan_cand, self.fan_count])
+                             [refresh_all, self._counts, self._dirty_vertices, self.s_mesh, state.pair_mode,
+                              state.pair_dropped, self.s_cache])
                 self._cand_count.zero_()
                 self._launch(list_candidates, m.node_count, [self.node_flag, self._cand_count, self._cand_list])
                 self._n_cand = int(self._cand_count.numpy()[0]) if cpu else m.node_count
         self._cache_fresh = bool(use_cache)
-        held, window, touch = int(bool(self.held_faces)), int(self.near_window), 1e-9 * self.h_min
+        prm = self._params()
         node_list, counts, dim = self._all_nodes, self._counts_all, m.node_count
         if use_cache and self._n_cand == 0:
             return                                    # no node has an exposed edge
         if use_cache:
             self._launch(select_contact_nodes, self._n_cand,
-                         [self._cand_list, self._cand_count, state.x, touch, step, window, held, self.elem_near, self.query_after, self.contact_slot,
-                          self.node_flag, self.fan_cand, self.fan_count, self._counts, self._node_list])
+                         [self._cand_list, self._cand_count, state.x, prm, step, self.s_cache, self.contact_slot,
+                          self._counts, self._node_list])
             node_list, counts = self._node_list, self._counts
             if cpu:
                 dim = int(self._counts.numpy()[1])
         if dim == 0:
             return
         self._launch(eval_block_contact, dim,
-                     [node_list, counts, use_cache, self.grid.id, self.points, self.sample_slot, self.cell_inv,
-                      self.cell_dim, self.cell_starts, self.cell_ends, self.sorted_xy, self.sorted_code,
-                      self.slot_iface, self.slot_l0, self.node_vertex, self.vertex_start, self.vertex_nodes,
-                      self.fan_index, m.node_mass, m.node_pairs, m.pair_i, m.pair_j, state.pair_mode,
-                      state.pair_dropped, state.x, state.v, self.kn_area, self.mu_f, radius, 0.5 * self.h_min, touch,
-                      self.h_min, step, window, int(self.rebuild_interval), held, float(dt), self.node_face,
-                      self.fan_excl, self.fan_cand, self.fan_count, self.elem_near, self.query_after,
-                      self.contact_slot, self.contact_fs, self.contact_d0, self.contact_p, self.contact_kc, state.f,
-                      state.energy_acc, self.loss_acc])
+                     [node_list, counts, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist, prm,
+                      state.pair_mode, state.pair_dropped, state.x, state.v, step, float(dt), state.f,
+                      state.energy_acc])
 
     # ------------------------------------------------------------------ diagnostics (host side, not per step)
     def stored_energy(self) -> float:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import warp as wp
 
+from .contact_data import ContactCache, ContactMesh, ContactParams
 from .contact_geometry import (
     FAN_CACHE,
     WEDGE_TOL,
@@ -85,40 +86,30 @@ def corner_consider(
 
 
 @wp.func
-def fan_cache_build(
-    n: wp.int32,
-    excl: wp.int64,
-    node_vertex: wp.array(dtype=wp.int32),
-    vertex_start: wp.array(dtype=wp.int32),
-    vertex_nodes: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
-    pair_mode: wp.array(dtype=wp.int32),
-    fan_cand: wp.array2d(dtype=wp.int32),
-    fan_count: wp.array(dtype=wp.int32),
-):
+def fan_cache_build(n: wp.int32, excl: wp.int64, mesh: ContactMesh, pair_mode: wp.array(dtype=wp.int32),
+                    cache: ContactCache):
     """Cache the fan candidates of node n: the nodes at its vertex, in vertex order, of another element, not in
     its exclusion mask excl and with an exposed edge at the vertex, as 4·node + (1 if its edge 'node' is
     exposed) + (2 if its edge ending at the node is); fan_count −1 if more than FAN_CACHE (walk the fan)."""
     e = n // 3
-    vtx = node_vertex[n]
+    vtx = mesh.node_vertex[n]
     k = wp.int32(0)
-    for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
-        other = vertex_nodes[j]
+    for j in range(mesh.vertex_start[vtx], mesh.vertex_start[vtx + 1]):
+        other = mesh.vertex_nodes[j]
         if other // 3 != e:
-            if not in_mask(excl, other, fan_index):
+            if not in_mask(excl, other, mesh.fan_index):
                 code = wp.int32(0)
-                if slot_exposed(other, slot_iface, pair_mode):
+                if slot_exposed(other, mesh.slot_iface, pair_mode):
                     code = code + 1
-                if slot_exposed(slot_prev(other), slot_iface, pair_mode):
+                if slot_exposed(slot_prev(other), mesh.slot_iface, pair_mode):
                     code = code + 2
                 if code != 0:
                     if k < FAN_CACHE:
-                        fan_cand[n, k] = 4 * other + code
+                        cache.fan_cand[n, k] = 4 * other + code
                     k = k + 1
     if k > FAN_CACHE:
         k = wp.int32(-1)
-    fan_count[n] = k
+    cache.fan_count[n] = k
 
 
 @wp.func
@@ -150,21 +141,13 @@ def held_search(
     n: wp.int32,
     excl: wp.int64,
     use_cache: wp.int32,
-    node_vertex: wp.array(dtype=wp.int32),
-    vertex_start: wp.array(dtype=wp.int32),
-    vertex_nodes: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
+    mesh: ContactMesh,
     pair_mode: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
-    max_depth: wp.float64,
-    touch_tol: wp.float64,
-    fan_cand: wp.array2d(dtype=wp.int32),
-    fan_count: wp.array(dtype=wp.int32),
+    prm: ContactParams,
+    cache: ContactCache,
     wake: bool,
-    wake_dist: wp.float64,
     step: wp.int32,
-    elem_near: wp.array(dtype=wp.int32),
 ):
     """Search state (consider_edge) of node n against the other blocks at its own vertex only (module doc): all
     a held node searches, and the edges at its vertex for an open one. With use_cache, over its cached fan
@@ -180,6 +163,7 @@ def held_search(
     xn = x[n]
     xa = x[slot_prev(n)]
     xb = x[slot_end(n)]
+    touch_tol = prm.touch_tol
     st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
     # the node's element wedge (unit vectors along its two edges at the node), only once a corner test passes
     have_u = bool(False)
@@ -187,43 +171,44 @@ def held_search(
     u2 = wp.vec2d(zero, zero)
     cnt = wp.int32(-1)
     if use_cache != 0:
-        cnt = fan_count[n]
+        cnt = cache.fan_count[n]
     if cnt >= 0:
         for k in range(cnt):
-            code = fan_cand[n, k]
+            code = cache.fan_cand[n, k]
             other = code >> 2
             ex1 = (code & 1) != 0
             ex2 = (code & 2) != 0
             if wake:
-                if far_nodes_near(other, xa, xn, xb, x, wake_dist):
-                    elem_near[other // 3] = step
+                if far_nodes_near(other, xa, xn, xb, x, prm.wake_dist):
+                    cache.elem_near[other // 3] = step
             if corner_inside(xn, other, ex1, ex2, x, touch_tol):
                 if not have_u:
                     u1 = wp.normalize(x[slot_end(n)] - xn)
                     u2 = wp.normalize(x[slot_prev(n)] - xn)
                     have_u = True
-                st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st, max_depth, touch_tol)
+                st = corner_consider(other, ex1, ex2, xn, u1, u2, x, mesh.slot_iface, pair_mode, st, prm.max_depth,
+                                     touch_tol)
     else:
-        vtx = node_vertex[n]
-        for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
-            other = vertex_nodes[j]
+        vtx = mesh.node_vertex[n]
+        for j in range(mesh.vertex_start[vtx], mesh.vertex_start[vtx + 1]):
+            other = mesh.vertex_nodes[j]
             if other // 3 != e:
-                if not in_mask(excl, other, fan_index):
-                    ex1 = slot_exposed(other, slot_iface, pair_mode)
-                    ex2 = slot_exposed(slot_prev(other), slot_iface, pair_mode)
+                if not in_mask(excl, other, mesh.fan_index):
+                    ex1 = slot_exposed(other, mesh.slot_iface, pair_mode)
+                    ex2 = slot_exposed(slot_prev(other), mesh.slot_iface, pair_mode)
                     # only a node inside the corner (behind both exposed edges) can be a contact: a cheap sign
                     # test first, the full evaluation for the few that pass
                     if wake and (ex1 or ex2):
-                        if far_nodes_near(other, xa, xn, xb, x, wake_dist):
-                            elem_near[other // 3] = step
+                        if far_nodes_near(other, xa, xn, xb, x, prm.wake_dist):
+                            cache.elem_near[other // 3] = step
                     if ex1 or ex2:
                         if corner_inside(xn, other, ex1, ex2, x, touch_tol):
                             if not have_u:
                                 u1 = wp.normalize(x[slot_end(n)] - xn)
                                 u2 = wp.normalize(x[slot_prev(n)] - xn)
                                 have_u = True
-                            st = corner_consider(other, ex1, ex2, xn, u1, u2, x, slot_iface, pair_mode, st,
-                                                 max_depth, touch_tol)
+                            st = corner_consider(other, ex1, ex2, xn, u1, u2, x, mesh.slot_iface, pair_mode, st,
+                                                 prm.max_depth, touch_tol)
     return st
 
 
@@ -306,22 +291,10 @@ def refresh_fan_cache(
     refresh_all: wp.int32,
     counts: wp.array(dtype=wp.int32),
     dirty_vertices: wp.array(dtype=wp.int32),
-    node_vertex: wp.array(dtype=wp.int32),
-    vertex_start: wp.array(dtype=wp.int32),
-    vertex_nodes: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
-    slot_l0: wp.array(dtype=wp.float64),
-    node_pairs: wp.array(dtype=wp.vec2i),
-    pair_i: wp.array(dtype=wp.int32),
-    pair_j: wp.array(dtype=wp.int32),
+    mesh: ContactMesh,
     pair_mode: wp.array(dtype=wp.int32),
     pair_dropped: wp.array(dtype=wp.int32),
-    node_face: wp.array(dtype=wp.vec2d),
-    node_flag: wp.array(dtype=wp.int32),
-    fan_excl: wp.array(dtype=wp.int64),
-    fan_cand: wp.array2d(dtype=wp.int32),
-    fan_count: wp.array(dtype=wp.int32),
+    cache: ContactCache,
 ):
     """Rebuild the caches (node_faces and node_flag, fan_exclusions mask, fan_cache_build list) of every node at
     a listed vertex (every vertex with refresh_all): each thread writes only its own vertex's nodes, from the
@@ -332,20 +305,19 @@ def refresh_fan_cache(
         if i >= counts[0]:
             return
         vtx = dirty_vertices[i]
-    for j in range(vertex_start[vtx], vertex_start[vtx + 1]):
-        n = vertex_nodes[j]
-        nf = node_faces(n, slot_iface, slot_l0, pair_mode, pair_dropped)
-        node_face[n] = nf
+    for j in range(mesh.vertex_start[vtx], mesh.vertex_start[vtx + 1]):
+        n = mesh.vertex_nodes[j]
+        nf = node_faces(n, mesh.slot_iface, mesh.slot_l0, pair_mode, pair_dropped)
+        cache.node_face[n] = nf
         flag = wp.int32(0)                        # 0 no exposed edge, 1 held, 2 open
         if nf[0] != wp.float64(0.0):
             flag = 1
             if nf[1] != wp.float64(0.0):
                 flag = 2
-        node_flag[n] = flag
-        ex = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
-        fan_excl[n] = ex
-        fan_cache_build(n, ex, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface, pair_mode,
-                        fan_cand, fan_count)
+        cache.node_flag[n] = flag
+        ex = fan_exclusions(n, mesh.node_pairs, mesh.fan_index, mesh.pair_i, mesh.pair_j, pair_mode, pair_dropped)
+        cache.fan_excl[n] = ex
+        fan_cache_build(n, ex, mesh, pair_mode, cache)
 
 
 @wp.kernel
@@ -363,16 +335,10 @@ def select_contact_nodes(
     cand_list: wp.array(dtype=wp.int32),
     cand_count: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
-    touch_tol: wp.float64,
+    prm: ContactParams,
     step: wp.int32,
-    near_window: wp.int32,
-    held_faces: wp.int32,
-    elem_near: wp.array(dtype=wp.int32),
-    query_after: wp.array(dtype=wp.int32),
+    cache: ContactCache,
     contact_slot: wp.array(dtype=wp.int32),
-    node_flag: wp.array(dtype=wp.int32),
-    fan_cand: wp.array2d(dtype=wp.int32),
-    fan_count: wp.array(dtype=wp.int32),
     counts: wp.array(dtype=wp.int32),
     node_list: wp.array(dtype=wp.int32),
 ):
@@ -384,27 +350,27 @@ def select_contact_nodes(
     if i >= cand_count[0]:
         return
     n = cand_list[i]
-    flag = node_flag[n]
+    flag = cache.node_flag[n]
     if flag == 0:
         return
     is_open = flag == 2
-    woken = node_woken(n // 3, elem_near, step, near_window)
+    woken = node_woken(n // 3, cache.elem_near, step, prm.near_window)
     # open nodes are listed whenever they have a fan (its search and wake run every step), the hash search
     # when due
     if not (is_open or woken):
         if contact_slot[n] < 0:
-            if held_faces == 0:
+            if prm.held_faces == 0:
                 return                            # held broken faces not searched (BlockContact.held_faces)
-            cnt = fan_count[n]
+            cnt = cache.fan_count[n]
             if cnt >= 0:
                 xn = x[n]
                 hit = bool(False)
                 for k in range(cnt):
-                    code = fan_cand[n, k]
+                    code = cache.fan_cand[n, k]
                     other = code >> 2
                     ex1 = (code & 1) != 0
                     ex2 = (code & 2) != 0
-                    if not hit and corner_inside(xn, other, ex1, ex2, x, touch_tol):
+                    if not hit and corner_inside(xn, other, ex1, ex2, x, prm.touch_tol):
                         # the corner's exposed edges: can consider_edge take either? (edge_may_take)
                         e1 = x[slot_end(n)] - xn
                         e2 = x[slot_prev(n)] - xn
@@ -417,6 +383,6 @@ def select_contact_nodes(
                 if not hit:
                     return
     # a quiet open node (BlockContact doc) without contact is left with its fan search: none if its fan is empty
-    elif is_open and not woken and step < query_after[n] and contact_slot[n] < 0 and fan_count[n] == 0:
+    elif is_open and not woken and step < cache.query_after[n] and contact_slot[n] < 0 and cache.fan_count[n] == 0:
         return
     node_list[wp.atomic_add(counts, 1, 1)] = n

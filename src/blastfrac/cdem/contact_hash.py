@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import warp as wp
 
+from .contact_data import ContactCache, ContactHash, ContactMesh, ContactParams
 from .contact_geometry import (
     consider_edge,
     edge_coords,
@@ -149,16 +150,12 @@ def hash_edge(
     excl: wp.int64,
     is_open: bool,
     skip_vertex: bool,
-    node_vertex: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
+    mesh: ContactMesh,
     pair_mode: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
-    max_depth: wp.float64,
-    touch_tol: wp.float64,
-    wake_dist: wp.float64,
+    prm: ContactParams,
     step: wp.int32,
-    elem_near: wp.array(dtype=wp.int32),
+    cache: ContactCache,
     sr: vec6d,
 ):
     """hash_search for one exposed edge s of another element within the search radius: sr = (search state of
@@ -167,20 +164,20 @@ def hash_edge(
     s_end = slot_end(s)
     skip = bool(False)
     corner = wp.int32(-1)
-    if node_vertex[s] == vtx:
-        skip = skip_vertex or in_mask(excl, s, fan_index)
+    if mesh.node_vertex[s] == vtx:
+        skip = skip_vertex or in_mask(excl, s, mesh.fan_index)
         corner = slot_prev(s)
-    elif node_vertex[s_end] == vtx:
-        skip = skip_vertex or in_mask(excl, s_end, fan_index)
+    elif mesh.node_vertex[s_end] == vtx:
+        skip = skip_vertex or in_mask(excl, s_end, mesh.fan_index)
         corner = s_end
     out = sr
     if not skip:
         c = edge_coords(xn, x[s], x[s_end])
-        st = consider_edge(s, c, corner, xn, u1, u2, x, slot_iface, pair_mode,
-                           vec5d(sr[0], sr[1], sr[2], sr[3], sr[4]), max_depth, touch_tol)
+        st = consider_edge(s, c, corner, xn, u1, u2, x, mesh.slot_iface, pair_mode,
+                           vec5d(sr[0], sr[1], sr[2], sr[3], sr[4]), prm.max_depth, prm.touch_tol)
         out = vec6d(st[0], st[1], st[2], st[3], st[4], wp.min(sr[5], c[2]))
-        if is_open and c[2] < wake_dist:
-            elem_near[s // 3] = step          # wake the block this open face comes near
+        if is_open and c[2] < prm.wake_dist:
+            cache.elem_near[s // 3] = step    # wake the block this open face comes near
     return out
 
 
@@ -192,78 +189,65 @@ def hash_search(
     st0: vec5d,
     excl: wp.int64,
     use_cache: wp.int32,
-    grid: wp.uint64,
-    points: wp.array(dtype=wp.vec3d),
-    sample_slot: wp.array(dtype=wp.int32),
-    cell_inv: wp.float64,
-    cell_dim: wp.int32,
-    cell_starts: wp.array(dtype=wp.int32),
-    cell_ends: wp.array(dtype=wp.int32),
-    sorted_xy: wp.array(dtype=wp.vec2d),
-    sorted_code: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
-    node_vertex: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
+    hsh: ContactHash,
+    mesh: ContactMesh,
     pair_mode: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
-    search_radius: wp.float64,
-    max_depth: wp.float64,
-    touch_tol: wp.float64,
-    wake_dist: wp.float64,
+    prm: ContactParams,
     step: wp.int32,
-    quiet_steps: wp.int32,
-    elem_near: wp.array(dtype=wp.int32),
-    query_after: wp.array(dtype=wp.int32),
+    cache: ContactCache,
 ):
     """Search state (consider_edge) of an open or woken node n over every exposed edge near it, through the
     spatial hash, from search state st0; excl: its fan_exclusions mask. With skip_vertex, over those that do not
     end at the node's own vertex (an open node, whose fan search has those). Wakes the blocks an open face comes
-    near and sets the node's quiet period (BlockContact doc): quiet if no edge it looked at is within wake_dist. With use_cache the points come from the cell grid (the cells wp.HashGrid
-    would visit, in its order, each cell's points in its order) with their exposure in sorted_code; without,
-    from wp.HashGrid itself."""
+    near and sets the node's quiet period (BlockContact doc): quiet if no edge it looked at is within wake_dist.
+    With use_cache the points come from the cell grid (the cells wp.HashGrid would visit, in its order, each
+    cell's points in its order) with their exposure in sorted_code; without, from wp.HashGrid itself."""
     e = n // 3
     zero = wp.float64(0.0)
     xn = x[n]
-    vtx = node_vertex[n]
+    vtx = mesh.node_vertex[n]
     # the node's element wedge: unit vectors along its two edges at the node
     u1 = wp.normalize(x[slot_end(n)] - xn)
     u2 = wp.normalize(x[slot_prev(n)] - xn)
     sr = vec6d(st0[0], st0[1], st0[2], st0[3], st0[4], wp.float64(1.0e300))
-    r2 = search_radius * search_radius
+    radius = prm.search_radius
+    r2 = radius * radius
     if use_cache != 0:
-        xs = cell_coord((xn[0] - search_radius) * cell_inv)
-        xe = cell_end(xs, cell_coord((xn[0] + search_radius) * cell_inv), cell_dim)
-        ys = cell_coord((xn[1] - search_radius) * cell_inv)
-        ye = cell_end(ys, cell_coord((xn[1] + search_radius) * cell_inv), cell_dim)
+        dim = hsh.cell_dim
+        xs = cell_coord((xn[0] - radius) * hsh.cell_inv)
+        xe = cell_end(xs, cell_coord((xn[0] + radius) * hsh.cell_inv), dim)
+        ys = cell_coord((xn[1] - radius) * hsh.cell_inv)
+        ye = cell_end(ys, cell_coord((xn[1] + radius) * hsh.cell_inv), dim)
         for cy in range(ys, ye + 1):
-            row = cell_wrap(cy, cell_dim) * cell_dim
+            row = cell_wrap(cy, dim) * dim
             for cx in range(xs, xe + 1):
-                c = row + cell_wrap(cx, cell_dim)
-                for j in range(cell_starts[c], cell_ends[c]):
-                    code = sorted_code[j]
+                c = row + cell_wrap(cx, dim)
+                for j in range(hsh.cell_starts[c], hsh.cell_ends[c]):
+                    code = hsh.sorted_code[j]
                     if code > 0:                       # an exposed edge
                         s = code - 1
-                        pt = sorted_xy[j]
+                        pt = hsh.sorted_xy[j]
                         dx = pt[0] - xn[0]
                         dy = pt[1] - xn[1]
                         # whole hash cells: keep the points within the search radius
                         if s // 3 != e and dx * dx + dy * dy <= r2:
-                            sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, skip_vertex, node_vertex, fan_index, slot_iface,
-                                           pair_mode, x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
+                            sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, skip_vertex, mesh, pair_mode, x, prm,
+                                           step, cache, sr)
     else:
-        query = wp.hash_grid_query(grid, wp.vec3d(xn[0], xn[1], zero), search_radius)
+        query = wp.hash_grid_query(hsh.grid, wp.vec3d(xn[0], xn[1], zero), radius)
         i = int(0)
         while wp.hash_grid_query_next(query, i):
-            s = sample_slot[i]
-            p3 = points[i]
+            s = hsh.sample_slot[i]
+            p3 = hsh.points[i]
             dx = p3[0] - xn[0]
             dy = p3[1] - xn[1]
             # the query returns whole hash cells: keep the points within the search radius
             if s // 3 != e and dx * dx + dy * dy <= r2:
-                if slot_exposed(s, slot_iface, pair_mode):
-                    sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, skip_vertex, node_vertex, fan_index, slot_iface, pair_mode,
-                                   x, max_depth, touch_tol, wake_dist, step, elem_near, sr)
-    query_after[n] = 0
-    if is_open and sr[5] >= wake_dist:
-        query_after[n] = step + quiet_steps
+                if slot_exposed(s, mesh.slot_iface, pair_mode):
+                    sr = hash_edge(s, xn, u1, u2, vtx, excl, is_open, skip_vertex, mesh, pair_mode, x, prm, step,
+                                   cache, sr)
+    cache.query_after[n] = 0
+    if is_open and sr[5] >= prm.wake_dist:
+        cache.query_after[n] = step + prm.quiet_steps
     return vec5d(sr[0], sr[1], sr[2], sr[3], sr[4])

@@ -6,6 +6,7 @@ from __future__ import annotations
 import warp as wp
 
 from ..model.model import CONTACT_DISSIPATED
+from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh, ContactParams
 from .contact_fan import held_search, node_faces, node_woken
 from .contact_geometry import (
     KC_CAP,
@@ -27,20 +28,14 @@ def contact_force(
     n: wp.int32,
     trib: wp.float64,
     st: vec5d,
-    node_mass: wp.array(dtype=wp.float64),
+    mesh: ContactMesh,
+    prm: ContactParams,
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
-    kn_area: wp.float64,
-    mu_f: wp.float64,
     dt: wp.float64,
-    contact_slot: wp.array(dtype=wp.int32),
-    contact_fs: wp.array(dtype=wp.float64),
-    contact_d0: wp.array(dtype=wp.float64),
-    contact_p: wp.array(dtype=wp.float64),
-    contact_kc: wp.array(dtype=wp.float64),
+    hist: ContactHistory,
     f: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
-    loss_acc: wp.array(dtype=wp.float64),
 ):
     """Contact forces of candidate node n (trib: its tributary length [m]) from its search state st
     (hash_search or held_search) and its contact history; see the module doc."""
@@ -50,10 +45,10 @@ def contact_force(
     xn = x[n]
     best = int(st[0])
     near_inside = st[4] > zero
-    prev = contact_slot[n]
-    p_prev = contact_p[n]
-    kc_prev = contact_kc[n]
-    fs_prev = contact_fs[n]
+    prev = hist.slot[n]
+    p_prev = hist.p[n]
+    kc_prev = hist.kc[n]
+    fs_prev = hist.fs[n]
     found = best >= 0 and near_inside
     # history: 0 new contact, 1 same edge as the last step, 2 another edge, 3 lost (last step's edge, p > 0)
     history = wp.int32(0)
@@ -70,12 +65,12 @@ def contact_force(
         if prev >= 0:                             # contact ends at zero overlap: only its friction spring is dropped
             lost0 = half * fs_prev * fs_prev / kc_prev
             wp.atomic_add(energy_acc, CONTACT_DISSIPATED, lost0)
-            wp.atomic_add(loss_acc, LOSS_PENALTY, lost0)
-        contact_slot[n] = -1
-        contact_fs[n] = zero
-        contact_d0[n] = zero
-        contact_p[n] = zero
-        contact_kc[n] = zero
+            wp.atomic_add(hist.loss_acc, LOSS_PENALTY, lost0)
+        hist.slot[n] = -1
+        hist.fs[n] = zero
+        hist.d0[n] = zero
+        hist.p[n] = zero
+        hist.kc[n] = zero
         return
     ia = edge
     ib = slot_end(edge)
@@ -85,8 +80,8 @@ def contact_force(
     t_hat = ab_c / wp.length(ab_c)
     n_hat = wp.vec2d(t_hat[1], -t_hat[0])
     # penalty Kc = kn·A_node [Pa = N/m per m of overlap], capped at KC_CAP·m_min/Δt² (see module doc)
-    m_min = wp.min(node_mass[n], wp.min(node_mass[ia], node_mass[ib]))
-    kc = wp.min(kn_area * trib, KC_CAP * m_min / (dt * dt))
+    m_min = wp.min(mesh.node_mass[n], wp.min(mesh.node_mass[ia], mesh.node_mass[ib]))
+    kc = wp.min(prm.kn_area * trib, KC_CAP * m_min / (dt * dt))
     fn = zero
     fs = zero
     lost = zero
@@ -97,12 +92,12 @@ def contact_force(
     p = zero
     d0 = zero
     if history == 3 or history == 1:
-        p_raw = pen - contact_d0[n]
+        p_raw = pen - hist.d0[n]
         if p_raw < zero and p_prev > zero:        # separation within the step: release force (module doc)
             q = release_overlap(p_prev, p_raw)
             fn = kc_prev * q
             # a sliding contact's friction impulse is corrected the same way (below); a sticking one is not
-            released = wp.abs(fs_prev) >= (one - wp.float64(1.0e-9)) * mu_f * kc_prev * p_prev
+            released = wp.abs(fs_prev) >= (one - wp.float64(1.0e-9)) * prm.mu_f * kc_prev * p_prev
             fs_release = fs_prev * q / p_prev
             d0 = pen
             lost = half * fs_prev * fs_prev / kc_prev
@@ -111,14 +106,14 @@ def contact_force(
         if history == 3:
             keep = False
         elif p_raw >= zero or p_prev == zero:     # ordinary contact on the same edge (or resting at p = 0)
-            ov = penalty_overlap(1, pen, contact_d0[n], p_prev, kc_prev, kc)
+            ov = penalty_overlap(1, pen, hist.d0[n], p_prev, kc_prev, kc)
             p = ov[0]
             d0 = ov[1]
             lost = ov[2]
             fs = fs_prev
             fn = kc * p
     else:
-        ov2 = penalty_overlap(history, pen, contact_d0[n], p_prev, kc_prev, kc)
+        ov2 = penalty_overlap(history, pen, hist.d0[n], p_prev, kc_prev, kc)
         p = ov2[0]
         d0 = ov2[1]
         lost = ov2[2]
@@ -127,34 +122,34 @@ def contact_force(
         fn = kc * p
     if lost > zero:
         wp.atomic_add(energy_acc, CONTACT_DISSIPATED, lost)
-        wp.atomic_add(loss_acc, LOSS_PENALTY, lost)
+        wp.atomic_add(hist.loss_acc, LOSS_PENALTY, lost)
     vt = wp.dot(v[n] - ((one - xi) * v[ia] + xi * v[ib]), t_hat)
     if fn > zero:
-        cu = coulomb_update(fs, kc, vt, dt, mu_f * fn)
+        cu = coulomb_update(fs, kc, vt, dt, prm.mu_f * fn)
         fs = cu[0]
         if cu[1] > zero:
             wp.atomic_add(energy_acc, CONTACT_DISSIPATED, cu[1])
-            wp.atomic_add(loss_acc, LOSS_SLIP, cu[1])
+            wp.atomic_add(hist.loss_acc, LOSS_SLIP, cu[1])
     elif released:
         # the same first-order correction of the last step's tangential impulse (|Fs| ≤ μ|Fn| still holds);
         # its work is taken off the slip loss booked in the steps before
         fs = fs_release
         wp.atomic_add(energy_acc, CONTACT_DISSIPATED, -fs * vt * dt)
-        wp.atomic_add(loss_acc, LOSS_SLIP, -fs * vt * dt)
+        wp.atomic_add(hist.loss_acc, LOSS_SLIP, -fs * vt * dt)
     else:
         fs = zero
     if keep:
-        contact_slot[n] = edge
-        contact_fs[n] = fs
-        contact_d0[n] = d0
-        contact_p[n] = p
-        contact_kc[n] = kc
+        hist.slot[n] = edge
+        hist.fs[n] = fs
+        hist.d0[n] = d0
+        hist.p[n] = p
+        hist.kc[n] = kc
     else:
-        contact_slot[n] = -1
-        contact_fs[n] = zero
-        contact_d0[n] = zero
-        contact_p[n] = zero
-        contact_kc[n] = zero
+        hist.slot[n] = -1
+        hist.fs[n] = zero
+        hist.d0[n] = zero
+        hist.p[n] = zero
+        hist.kc[n] = zero
     force = fn * n_hat + fs * t_hat
     wp.atomic_add(f, n, force)
     wp.atomic_add(f, ia, -(one - xi) * force)
@@ -167,54 +162,19 @@ def eval_block_contact(
     node_list: wp.array(dtype=wp.int32),
     counts: wp.array(dtype=wp.int32),
     use_cache: wp.int32,
-    grid: wp.uint64,
-    points: wp.array(dtype=wp.vec3d),
-    sample_slot: wp.array(dtype=wp.int32),
-    cell_inv: wp.float64,
-    cell_dim: wp.int32,
-    cell_starts: wp.array(dtype=wp.int32),
-    cell_ends: wp.array(dtype=wp.int32),
-    sorted_xy: wp.array(dtype=wp.vec2d),
-    sorted_code: wp.array(dtype=wp.int32),
-    slot_iface: wp.array(dtype=wp.int32),
-    slot_l0: wp.array(dtype=wp.float64),
-    node_vertex: wp.array(dtype=wp.int32),
-    vertex_start: wp.array(dtype=wp.int32),
-    vertex_nodes: wp.array(dtype=wp.int32),
-    fan_index: wp.array(dtype=wp.int32),
-    node_mass: wp.array(dtype=wp.float64),
-    node_pairs: wp.array(dtype=wp.vec2i),
-    pair_i: wp.array(dtype=wp.int32),
-    pair_j: wp.array(dtype=wp.int32),
+    mesh: ContactMesh,
+    hsh: ContactHash,
+    cache: ContactCache,
+    hist: ContactHistory,
+    prm: ContactParams,
     pair_mode: wp.array(dtype=wp.int32),
     pair_dropped: wp.array(dtype=wp.int32),
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
-    kn_area: wp.float64,
-    mu_f: wp.float64,
-    search_radius: wp.float64,
-    max_depth: wp.float64,
-    touch_tol: wp.float64,
-    wake_dist: wp.float64,
     step: wp.int32,
-    near_window: wp.int32,
-    quiet_steps: wp.int32,
-    held_faces: wp.int32,
     dt: wp.float64,
-    node_face: wp.array(dtype=wp.vec2d),
-    fan_excl: wp.array(dtype=wp.int64),
-    fan_cand: wp.array2d(dtype=wp.int32),
-    fan_count: wp.array(dtype=wp.int32),
-    elem_near: wp.array(dtype=wp.int32),
-    query_after: wp.array(dtype=wp.int32),
-    contact_slot: wp.array(dtype=wp.int32),
-    contact_fs: wp.array(dtype=wp.float64),
-    contact_d0: wp.array(dtype=wp.float64),
-    contact_p: wp.array(dtype=wp.float64),
-    contact_kc: wp.array(dtype=wp.float64),
     f: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
-    loss_acc: wp.array(dtype=wp.float64),
 ):
     """Contact of each listed node (select_contact_nodes). The tests that listed it are made again here, in
     list order, so that the result is that of one pass over every node in node order (a node's woken flag can
@@ -226,44 +186,35 @@ def eval_block_contact(
     zero = wp.float64(0.0)
     nf = wp.vec2d()
     if use_cache != 0:
-        nf = node_face[n]
+        nf = cache.node_face[n]
     else:
-        nf = node_faces(n, slot_iface, slot_l0, pair_mode, pair_dropped)
+        nf = node_faces(n, mesh.slot_iface, mesh.slot_l0, pair_mode, pair_dropped)
     if nf[0] == zero:
         return                                    # no exposed edge at the node (listed nodes always have one)
     is_open = nf[1] != zero
-    woken = node_woken(n // 3, elem_near, step, near_window)
-    if not (is_open or woken) and held_faces == 0 and contact_slot[n] < 0:
+    woken = node_woken(n // 3, cache.elem_near, step, prm.near_window)
+    if not (is_open or woken) and prm.held_faces == 0 and hist.slot[n] < 0:
         return                                    # held broken faces not searched (BlockContact.held_faces)
     excl = wp.int64(0)
     if use_cache != 0:
-        excl = fan_excl[n]
+        excl = cache.fan_excl[n]
     else:
-        excl = fan_exclusions(n, node_pairs, fan_index, pair_i, pair_j, pair_mode, pair_dropped)
+        excl = fan_exclusions(n, mesh.node_pairs, mesh.fan_index, mesh.pair_i, mesh.pair_j, pair_mode, pair_dropped)
     st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
     if is_open:
         # the edges at its own vertex from its fan (as a held node), every step; the others through the hash,
         # unless it is quiet (its last search saw no such edge within wake_dist, BlockContact doc)
-        st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,
-                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count, True, wake_dist, step, elem_near)
-        if woken or step >= query_after[n] or contact_slot[n] >= 0:
-            st = hash_search(n, True, True, st, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim,
-                             cell_starts, cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index,
-                             pair_mode, x, search_radius, max_depth, touch_tol, wake_dist, step, quiet_steps,
-                             elem_near, query_after)
+        st = held_search(n, excl, use_cache, mesh, pair_mode, x, prm, cache, True, step)
+        if woken or step >= cache.query_after[n] or hist.slot[n] >= 0:
+            st = hash_search(n, True, True, st, excl, use_cache, hsh, mesh, pair_mode, x, prm, step, cache)
         elif st[0] < zero:
             return
     elif woken:
-        st = hash_search(n, False, False, st, excl, use_cache, grid, points, sample_slot, cell_inv, cell_dim,
-                         cell_starts, cell_ends, sorted_xy, sorted_code, slot_iface, node_vertex, fan_index,
-                         pair_mode, x, search_radius, max_depth, touch_tol, wake_dist, step, quiet_steps,
-                         elem_near, query_after)
-    elif held_faces != 0:
+        st = hash_search(n, False, False, st, excl, use_cache, hsh, mesh, pair_mode, x, prm, step, cache)
+    elif prm.held_faces != 0:
         # broken faces still held by their springs, not woken: only the other blocks at the node's vertex
-        st = held_search(n, excl, use_cache, node_vertex, vertex_start, vertex_nodes, fan_index, slot_iface,
-                         pair_mode, x, max_depth, touch_tol, fan_cand, fan_count, False, wake_dist, step, elem_near)
+        st = held_search(n, excl, use_cache, mesh, pair_mode, x, prm, cache, False, step)
         # nothing found and no contact to end: contact_force would only rewrite the zeros of a node without one
-        if st[0] < zero and contact_slot[n] < 0:
+        if st[0] < zero and hist.slot[n] < 0:
             return
-    contact_force(n, nf[0], st, node_mass, x, v, kn_area, mu_f, dt, contact_slot, contact_fs, contact_d0,
-                  contact_p, contact_kc, f, energy_acc, loss_acc)
+    contact_force(n, nf[0], st, mesh, prm, x, v, dt, hist, f, energy_acc)
