@@ -24,37 +24,80 @@ def stored_spring_energy(fn: wp.float64, fs: wp.float64, kn: wp.float64, ks: wp.
     return half * fn * fn / kn + half * fs * fs / ks
 
 
+@wp.struct
+class SpringModel:
+    """The springs' fixed data (cdem/kernels_spring.py): the nodes of each pair, per-pair stiffness Kn, Ks [N/m per
+    m], area A_c [m], rest length L0 [m], per-pair law (tanφ, tanφ_r, slope_t, slope_c) and the model's scalars."""
+
+    pair_i: wp.array(dtype=wp.int32)
+    pair_j: wp.array(dtype=wp.int32)
+    kn: wp.array(dtype=wp.float64)
+    ks: wp.array(dtype=wp.float64)
+    ac: wp.array(dtype=wp.float64)
+    l0: wp.array(dtype=wp.float64)
+    law: wp.array(dtype=wp.vec4d)
+    node_mass: wp.array(dtype=wp.float64)       # [kg/m]
+    tan_phi: wp.float64
+    tan_phi_r: wp.float64
+    slope_t: wp.float64
+    slope_c: wp.float64
+    zeta: wp.float64                            # spring dashpot damping ratio [-]
+    per_pair_law: wp.int32
+    breakable: wp.int32
+
+
+@wp.struct
+class SpringState:
+    """Each spring's state (a State's pair_* arrays): force (Fn, Fs) [N/m], strengths, mode, dropped, gap at
+    break g0 [m], break time [s], work and fracture energy [J/m], and the force on its j node [N/m]."""
+
+    F: wp.array(dtype=wp.vec2d)
+    strength: wp.array(dtype=wp.vec2d)
+    mode: wp.array(dtype=wp.int32)
+    dropped: wp.array(dtype=wp.int32)
+    g0: wp.array(dtype=wp.float64)
+    tbreak: wp.array(dtype=wp.float64)
+    work: wp.array(dtype=wp.float64)
+    efrac: wp.array(dtype=wp.float64)
+    force: wp.array(dtype=wp.vec2d)
+
+
+def spring_model(model, sm: SpringModel | None = None) -> SpringModel:
+    """The SpringModel of ``model``; with ``sm``, only its scalars are set again (they can change during a run:
+    ``breakable`` during an in-situ stage)."""
+    if sm is None:
+        sm = SpringModel()
+        sm.pair_i, sm.pair_j, sm.kn, sm.ks = model.pair_i, model.pair_j, model.pair_kn, model.pair_ks
+        sm.ac, sm.l0, sm.law, sm.node_mass = model.pair_ac, model.pair_l0, model.pair_law, model.node_mass
+    sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c = model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c
+    sm.zeta, sm.per_pair_law, sm.breakable = model.spring_damping, int(model.per_pair_law), int(model.breakable)
+    return sm
+
+
+def spring_scalars(model) -> tuple:
+    """The model scalars a SpringModel holds (a change means spring_model must set them again)."""
+    return (model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c, model.spring_damping,
+            int(model.per_pair_law), int(model.breakable))
+
+
+def spring_state(state) -> SpringState:
+    """The SpringState of a State (the same arrays)."""
+    ss = SpringState()
+    ss.F, ss.strength, ss.mode, ss.dropped = state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped
+    ss.g0, ss.tbreak, ss.work, ss.efrac, ss.force = (state.pair_g0, state.pair_tbreak, state.pair_work,
+                                                    state.pair_efrac, state.pair_force)
+    return ss
+
+
 @wp.kernel
 def eval_spring_forces(
-    pair_i: wp.array(dtype=wp.int32),
-    pair_j: wp.array(dtype=wp.int32),
-    pair_kn: wp.array(dtype=wp.float64),
-    pair_ks: wp.array(dtype=wp.float64),
-    pair_ac: wp.array(dtype=wp.float64),
-    pair_l0: wp.array(dtype=wp.float64),
+    sm: SpringModel,
+    ss: SpringState,
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
-    pair_F: wp.array(dtype=wp.vec2d),
-    pair_str: wp.array(dtype=wp.vec2d),
-    pair_mode: wp.array(dtype=wp.int32),
-    pair_dropped: wp.array(dtype=wp.int32),
-    pair_g0: wp.array(dtype=wp.float64),
-    pair_tbreak: wp.array(dtype=wp.float64),
-    pair_work: wp.array(dtype=wp.float64),
-    pair_efrac: wp.array(dtype=wp.float64),
-    tan_phi: wp.float64,
-    tan_phi_r: wp.float64,
-    slope_t: wp.float64,
-    slope_c: wp.float64,
-    pair_law: wp.array(dtype=wp.vec4d),
-    per_pair_law: wp.int32,
-    breakable: wp.int32,
-    node_mass: wp.array(dtype=wp.float64),
-    zeta: wp.float64,
     dt: wp.float64,
     clock: wp.array(dtype=wp.float64),
     first: wp.int32,
-    pair_force: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
     """Update both springs of interface q; write the force on each pair's j node (global axes) [N/m].
@@ -73,13 +116,13 @@ def eval_spring_forces(
     half = wp.float64(0.5)
     pa = 2 * q
     pb = 2 * q + 1
-    ma = half * (x[pair_i[pa]] + x[pair_j[pa]])
-    mb = half * (x[pair_i[pb]] + x[pair_j[pb]])
+    ma = half * (x[sm.pair_i[pa]] + x[sm.pair_j[pa]])
+    mb = half * (x[sm.pair_i[pb]] + x[sm.pair_j[pb]])
     t = wp.normalize(mb - ma)
     n = wp.vec2d(t[1], -t[0])
     # frame of a broken pair: the e1 face (node-to-face contact of j against the edge i_a→i_b of e1).
     # The midpoint frame is meaningless once the other pair has opened or the blocks have turned.
-    tb = wp.normalize(x[pair_i[pb]] - x[pair_i[pa]])
+    tb = wp.normalize(x[sm.pair_i[pb]] - x[sm.pair_i[pa]])
     nb = wp.vec2d(tb[1], -tb[0])
     nn = n
     tt = t
@@ -87,37 +130,37 @@ def eval_spring_forces(
         nn = n
         tt = t
         k = pa + s
-        if pair_dropped[k] != 0:
-            pair_force[k] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
+        if ss.dropped[k] != 0:
+            ss.force[k] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
             continue
-        i = pair_i[k]
-        j = pair_j[k]
+        i = sm.pair_i[k]
+        j = sm.pair_j[k]
         dd = (v[j] - v[i]) * dt
         dn = wp.dot(dd, n)
         ds = wp.dot(dd, t)
-        f0 = pair_F[k]
-        kn = pair_kn[k]
-        ks = pair_ks[k]
+        f0 = ss.F[k]
+        kn = sm.kn[k]
+        ks = sm.ks[k]
         fn = wp.float64(0.0)
         fs = wp.float64(0.0)
-        law = wp.vec4d(tan_phi, tan_phi_r, slope_t, slope_c)
-        if per_pair_law != 0:
-            law = pair_law[k]
-        mode = pair_mode[k]
+        law = wp.vec4d(sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c)
+        if sm.per_pair_law != 0:
+            law = sm.law[k]
+        mode = ss.mode[k]
         if mode == 0:
-            st = pair_str[k]
-            r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, pair_ac[k],
-                                     law[0], law[1], law[2], law[3], breakable)
+            st = ss.strength[k]
+            r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, sm.ac[k],
+                                     law[0], law[1], law[2], law[3], sm.breakable)
             fn = r[0]
             fs = r[1]
-            pair_str[k] = wp.vec2d(r[2], r[3])
+            ss.strength[k] = wp.vec2d(r[2], r[3])
             new_mode = wp.int32(r[4])
-            w = pair_work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
-            pair_work[k] = w
+            w = ss.work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
+            ss.work[k] = w
             if new_mode != 0:
-                pair_mode[k] = new_mode
-                pair_tbreak[k] = clock[0]
-                pair_efrac[k] = w - stored_spring_energy(fn, fs, kn, ks)
+                ss.mode[k] = new_mode
+                ss.tbreak[k] = clock[0]
+                ss.efrac[k] = w - stored_spring_energy(fn, fs, kn, ks)
         else:
             nn = nb
             tt = tb
@@ -125,45 +168,39 @@ def eval_spring_forces(
             ds = wp.dot(dd, tt)
             rel = x[j] - x[i]
             gap = wp.dot(rel, nn)
-            g0 = pair_g0[k]
+            g0 = ss.g0[k]
             # separated (open by more than L0, slid by L0/2), or crossed by more than L0/2: leave it to §1.5
-            if wp.abs(gap - g0) > half * pair_l0[k] and gap - g0 < wp.float64(0.0):
-                pair_dropped[k] = 1
-            elif gap - g0 > pair_l0[k] or wp.abs(wp.dot(rel, tt)) > half * pair_l0[k]:
-                pair_dropped[k] = 1
+            if wp.abs(gap - g0) > half * sm.l0[k] and gap - g0 < wp.float64(0.0):
+                ss.dropped[k] = 1
+            elif gap - g0 > sm.l0[k] or wp.abs(wp.dot(rel, tt)) > half * sm.l0[k]:
+                ss.dropped[k] = 1
             else:
                 r2 = spring_update_broken(f0[1], gap, g0, ds, kn, ks, law[1])
                 fn = r2[0]
                 fs = r2[1]
-            pair_work[k] = pair_work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
-        pair_F[k] = wp.vec2d(fn, fs)
+            ss.work[k] = ss.work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
+        ss.F[k] = wp.vec2d(fn, fs)
         fv = fn * nn + fs * tt
-        if zeta > wp.float64(0.0) and (mode == 0 or fn > wp.float64(0.0)):
-            cd = spring_dashpot(v[j] - v[i], nn, tt, kn, ks, node_mass[i], node_mass[j], zeta)
+        if sm.zeta > wp.float64(0.0) and (mode == 0 or fn > wp.float64(0.0)):
+            cd = spring_dashpot(v[j] - v[i], nn, tt, kn, ks, sm.node_mass[i], sm.node_mass[j], sm.zeta)
             fv = fv + cd
             wp.atomic_add(energy_acc, DAMPING_DISSIPATED, -wp.dot(cd, v[j] - v[i]) * dt)
-        pair_force[k] = fv
+        ss.force[k] = fv
 
 
 def launch_spring_forces(model, state, dt: float, clock: wp.array, launch=wp.launch, first: int = 0,
-                         count: int | None = None, energy_acc: wp.array | None = None, key=None) -> None:
+                         count: int | None = None, energy_acc: wp.array | None = None, key=None,
+                         structs: tuple | None = None) -> None:
     """Interfaces first … first + count − 1 (all by default). clock: [1] the time at the start of the step [s], on
     the device (set before the step, and before each replay of a captured one); energy_acc: where the dashpots'
-    work goes (state.energy_acc by default)."""
+    work goes (state.energy_acc by default); structs: (SpringModel, SpringState) of model and state, if the caller
+    keeps them (CDEMSolver does), else built here."""
     count = model.interface_count - first if count is None else count
     if count <= 0:
         return
+    sm, ss = structs if structs is not None else (spring_model(model), spring_state(state))
     site = {} if key is None else {"key": key}        # a Launcher's call site (the plain wp.launch has none)
-    launch(
-        eval_spring_forces,
-        dim=count,
-        inputs=[model.pair_i, model.pair_j, model.pair_kn, model.pair_ks, model.pair_ac, model.pair_l0,
-                state.x, state.v, state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped,
-                state.pair_g0, state.pair_tbreak, state.pair_work, state.pair_efrac,
-                wp.float64(model.tan_phi), wp.float64(model.tan_phi_r), wp.float64(model.slope_t),
-                wp.float64(model.slope_c), model.pair_law, wp.int32(model.per_pair_law),
-                wp.int32(model.breakable), model.node_mass,
-                wp.float64(model.spring_damping), wp.float64(dt), clock, first],
-        outputs=[state.pair_force, state.energy_acc if energy_acc is None else energy_acc],
-        device=model.device, **site,
-    )
+    launch(eval_spring_forces, dim=count,
+           inputs=[sm, ss, state.x, state.v, wp.float64(dt), clock, first,
+                   state.energy_acc if energy_acc is None else energy_acc],
+           device=model.device, **site)

@@ -11,7 +11,7 @@ from .boundary import launch_edge_loads
 from .contact import BlockContact
 from .kernels_element import launch_element_forces, launch_gather_springs
 from .kernels_integrate import launch_integrate
-from .kernels_spring import launch_spring_forces
+from .kernels_spring import launch_spring_forces, spring_model, spring_scalars, spring_state
 
 
 class CDEMSolver:
@@ -36,6 +36,21 @@ class CDEMSolver:
         self.split_min = 10000                    # fewer interfaces: one launch (a hand-off costs ~85 µs here)
         self._energy_b = wp.zeros(4, dtype=wp.float64, device=model.device)   # energy_acc of the second half
         self._split_ready = False
+        # the spring kernel's structs (kernels_spring.SpringModel, SpringState): one model, one per State
+        self._spring_model = spring_model(model)
+        self._spring_scalars = spring_scalars(model)
+        self._spring_states: dict = {}
+
+    def _springs(self, state: State) -> tuple:
+        """(SpringModel, SpringState) for ``state``, the model's scalars as they are now."""
+        sc = spring_scalars(self.model)
+        if sc != self._spring_scalars:
+            spring_model(self.model, self._spring_model)
+            self._spring_scalars = sc
+        ss = self._spring_states.get(id(state))
+        if ss is None or ss[0] is not state:
+            ss = self._spring_states[id(state)] = (state, spring_state(state))
+        return self._spring_model, ss[1]
 
     def _set_clock(self, t: float) -> None:
         if self._clock_host is not None:
@@ -70,13 +85,14 @@ class CDEMSolver:
         m = self.model
         if self.pool is None or m.interface_count < self.split_min or m.device != "cpu" or not self._split_ready:
             self._split_ready = self.pool is not None            # the first call loads the module, in this thread
-            launch_spring_forces(m, state, dt, self.clock, self.launch)
+            launch_spring_forces(m, state, dt, self.clock, self.launch, structs=self._springs(state))
             return
         half = m.interface_count // 2
+        structs = self._springs(state)
         fut = self.pool.submit(launch_spring_forces, m, state, dt, self.clock, self.launch, half, None,
-                               self._energy_b, "b")
+                               self._energy_b, "b", structs)
         try:
-            launch_spring_forces(m, state, dt, self.clock, self.launch, 0, half, None, "a")
+            launch_spring_forces(m, state, dt, self.clock, self.launch, 0, half, None, "a", structs)
         finally:
             fut.result()
         self.launch(add_energy, dim=1, inputs=[self._energy_b], outputs=[state.energy_acc], device=m.device)
@@ -115,7 +131,7 @@ class CDEMSolver:
             self._set_clock(t)
             wp.capture_begin(device=m.device)
             try:
-                launch_spring_forces(m, state, dt, self.clock, self.launch)
+                launch_spring_forces(m, state, dt, self.clock, self.launch, structs=self._springs(state))
                 self.forces_rest(state, dt, t)
                 self.integrate(state, dt, alpha)
                 if after is not None:
