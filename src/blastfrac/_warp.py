@@ -72,8 +72,11 @@ class Launcher:
     size. Called like ``wp.launch(kernel, dim, inputs=..., outputs=..., device=...)``; ``key`` tells apart two call
     sites of one kernel with different arrays (each keeps its own record). A launch is recorded again whenever one
     of its arrays is another object than at the last call (another State, a reallocated array), and a struct
-    argument is packed again at every call (its fields may have changed), so a replay always runs on what it is
-    given; the same arguments give the same launch, bit for bit.
+    argument that is another object is packed again. The same struct object is not: Warp packs a struct as a
+    reference to the instance's own ctypes record (``StructInstance._ctype``), which its field assignments update
+    and every launch reads, so a replay sees fields set since (tests/unit/test_launcher.py checks this against
+    plain launches, so a Warp release that copied the record instead would fail there, not silently). A replay
+    thus always runs on what it is given; the same arguments give the same launch, bit for bit.
     ``Launcher(record=False)`` calls ``wp.launch`` every time (the reference of the tests). ``records`` counts the
     recordings (a count that keeps growing means a call site alternates between arrays and needs a key),
     ``replays`` the launches replayed (benchmarks count them beside the plain ``wp.launch`` calls)."""
@@ -92,8 +95,8 @@ class Launcher:
         if dim == 0:
             return                                   # wp.launch does nothing for an empty launch either
         rec = self._cmds.get((kernel, key))
-        if rec is not None and not rec[3] and params == rec[1]:
-            # the common case, nothing changed (arrays compare by identity, scalars by value): no struct to pack
+        if rec is not None and params == rec[1]:
+            # the common case, nothing changed (arrays and structs compare by identity, scalars by value)
             if dim != rec[2]:
                 rec[0].set_dim(dim)
                 rec[2] = dim
@@ -106,9 +109,10 @@ class Launcher:
                 if isinstance(a, wp.array):
                     if a is not last[i]:
                         break                        # another array: record again
-                elif hasattr(a, "_cls"):             # a struct, whose fields may have changed: pack it again
-                    cmd.set_param_at_index(i, a)
-                    last[i] = a
+                elif hasattr(a, "_cls"):             # a struct: another object is packed again
+                    if a is not last[i]:
+                        cmd.set_param_at_index(i, a)
+                        last[i] = a
                 elif a is not last[i] and a != last[i]:
                     cmd.set_param_at_index(i, a)
                     last[i] = a
@@ -121,6 +125,6 @@ class Launcher:
                 return
         with _RECORD_LOCK:                           # a first launch loads the kernel's module: one thread at a time
             cmd = wp.launch(kernel, dim=dim, inputs=params, device=device, record_cmd=True)
-        self._cmds[(kernel, key)] = [cmd, params, dim, any(hasattr(a, "_cls") for a in params)]
+        self._cmds[(kernel, key)] = [cmd, params, dim]
         self.records += 1
         cmd.launch()
