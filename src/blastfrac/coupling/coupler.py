@@ -18,8 +18,8 @@ import warp as wp
 from .._warp import Launcher
 from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
-from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, accumulate_gas_contact_work,
-                              accumulate_rock_contact_work, add_node_loads, collect_exposed_elements,
+from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, account_rock_work_and_clear,
+                              accumulate_gas_contact_work, add_reactions_with_work, collect_exposed_elements,
                               eval_particle_edge_contact)
 
 
@@ -67,6 +67,7 @@ class GasRockCoupler:
         self._launch = Launcher()                 # recorded launches of the per-step kernels (_warp.Launcher)
         self.f_react = wp.zeros(model.node_count, dtype=wp.vec2d, device=d)   # this step's reactions [N/m]
         self._dt_work = 0.0                     # step length of the forces whose second half of work is pending [s]
+        self._w_react = 0.0                     # ½Δt of this step's reactions, whose first half add_reactions books [s]
         # (particle, element) contact histories, read from one pair and written to the other each step
         nh = max(1, mpm.n) * CONTACT_HISTORY
         self._hist = [(wp.full(nh, -1, dtype=wp.int32, device=d), wp.zeros(nh, dtype=wp.float64, device=d),
@@ -145,54 +146,45 @@ class GasRockCoupler:
     def apply(self, state, dt: float) -> None:
         """Contact forces at the current positions: f_ext_p and f_ext_moment of the gas (assigned) and the rock
         reactions (into f_react; ``add_reactions`` adds them to state.f), and the work bookkeeping
-        (``_account_work``). Reads state.x, state.v and state.pair_mode only, so it may run beside the rock's
-        force stages once the springs have failed for this step."""
+        (kept inside the kernels: each step's work with the mean of the velocities before and after it, see
+        ``energies``). Reads state.x, state.v and state.pair_mode only, so it may run
+        beside the rock's force stages once the springs have failed for this step."""
         if self._since >= self.rebuild_interval:
             self._rebuild(state)
         self._since += 1
         mpm, m = self.mpm, self.model
-        self._account_work(state, self._dt_work)          # the last step's forces, velocities after that step
+        w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
+        self._launch(account_rock_work_and_clear, dim=m.node_count, inputs=[self.f_react, state.v, w_old, self.acc],
+                     device=m.device)
         self._launch(_reset_step_acc, dim=1, inputs=[], outputs=[self.acc], device=m.device)
-        self.f_react.zero_()
         self._dt_work = dt
+        self._w_react = 0.5 * dt                          # add_reactions books the first half of this step's
         if self.n_exposed == 0:
+            if w_old > 0.0:
+                self._launch(accumulate_gas_contact_work, dim=mpm.n,
+                             inputs=[mpm.f_ext_p, mpm.f_ext_moment, mpm.v_pic, mpm.grad_v, mpm.active, w_old],
+                             outputs=[self.acc], device=m.device)
             mpm.f_ext_p.zero_()
             mpm.f_ext_moment.zero_()
             self._hist[0][0].fill_(-1)
             return
         self._launch(eval_particle_edge_contact, dim=mpm.n,
-                  inputs=[self.grid.id, self.elems, self.points, self.elem_reach, self.slot_iface, state.pair_mode, state.x, state.v, m.node_mass,
-                          mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p, mpm.rho, mpm.active,
-                          wp.float64(self.kc), wp.float64(self.force_cap), wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
-                          wp.float64(self.query_radius), wp.float64(dt),
-                          wp.float64(float(self.surface_forces)), wp.float64(float(self.pressure_preload)),
-                          *self._hist[0]],
-                  outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1]],
-                  device=m.device, key=id(self._hist[0][0]))          # one record per history buffer
+                     inputs=[self.grid.id, self.elems, self.points, self.elem_reach, self.slot_iface, state.pair_mode,
+                             state.x, state.v, m.node_mass, mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p,
+                             mpm.rho, mpm.active, wp.float64(self.kc), wp.float64(self.force_cap),
+                             wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
+                             wp.float64(self.query_radius), wp.float64(dt), wp.float64(float(self.surface_forces)),
+                             wp.float64(float(self.pressure_preload)), wp.float64(w_old), wp.float64(0.5 * dt),
+                             *self._hist[0]],
+                     outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1]],
+                     device=m.device, key=id(self._hist[0][0]))          # one record per history buffer
         self._hist.reverse()
-        self._account_work(state, dt)                      # this step's forces, velocities before the step
 
     def add_reactions(self, state) -> None:
-        """state.f += this step's contact reactions (f_react)."""
-        self._launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_react], device=self.model.device)
-
-    def _account_work(self, state, dt: float) -> None:
-        """Add ½dt of the work of the current contact forces to the absorbed energy, with the present velocities.
-
-        Called with the new forces before the step (rock: v^{n−½}; gas: the last G2P's v_pic and L) and again
-        with the same forces after it (v^{n+½}; the new v_pic and L), so that each step's work is taken with the
-        mean of the velocities before and after it. This is the work the rock's central-difference update and
-        the gas grid actually receive: with the velocities before the step only, the rock side alone erred by
-        Σ|f|²Δt²/2m per step (about 2 % of the work done in the single-hole example).
-        """
-        if dt <= 0.0:
-            return
-        mpm, d = self.mpm, self.model.device
-        w = wp.float64(0.5 * dt)
-        self._launch(accumulate_gas_contact_work, dim=mpm.n,
-                  inputs=[mpm.f_ext_p, mpm.f_ext_moment, mpm.v_pic, mpm.grad_v, mpm.active, w], outputs=[self.acc], device=d)
-        self._launch(accumulate_rock_contact_work, dim=self.model.node_count, inputs=[self.f_react, state.v, w],
-                  outputs=[self.acc], device=d)
+        """state.f += this step's contact reactions (f_react), and the first half of their work at the rock's
+        velocities before the step."""
+        self._launch(add_reactions_with_work, dim=self.model.node_count,
+                     inputs=[state.f, self.f_react, state.v, self._w_react, self.acc], device=self.model.device)
 
     def energies(self) -> dict[str, float]:
         """contact_energy: work absorbed by the contacts so far, −∫(P_gas + P_rock) dt [J/m] with the power put into

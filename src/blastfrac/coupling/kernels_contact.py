@@ -22,6 +22,13 @@ def slot_exposed(s: wp.int32, slot_iface: wp.array(dtype=wp.int32), pair_mode: w
     return pair_mode[2 * q] > 0 and pair_mode[2 * q + 1] > 0
 
 
+@wp.func
+def contact_power(f: wp.vec2d, M: wp.mat22d, v: wp.vec2d, L: wp.mat22d):
+    """f·v + M:L [W/m]: the power of a contact force f [N/m] applied with moment M [N] (mpm.kernels_p2g.p2g) on a
+    particle moving at v [m/s] with velocity gradient L [1/s]."""
+    return wp.dot(f, v) + M[0, 0] * L[0, 0] + M[0, 1] * L[0, 1] + M[1, 0] * L[1, 0] + M[1, 1] * L[1, 1]
+
+
 @wp.kernel
 def collect_exposed_elements(
     slot_iface: wp.array(dtype=wp.int32),
@@ -85,6 +92,8 @@ def eval_particle_edge_contact(
     dt: wp.float64,
     surface: wp.float64,
     preload: wp.float64,
+    w_old: wp.float64,
+    w_new: wp.float64,
     hist_e_in: wp.array(dtype=wp.int32),
     hist_d_in: wp.array(dtype=wp.float64),
     hist_x_in: wp.array(dtype=wp.float64),
@@ -103,6 +112,10 @@ def eval_particle_edge_contact(
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
     each (8·element + feature, ignored initial overlap δ₀ [m], effective overlap δ − δ₀ [m]); feature 0–2:
     edge k, 3–5: vertex k; −1 marks an empty slot.
+
+    The contact-work book (GasRockCoupler.energies) of the gas side is kept here too: acc[ABSORBED] −=
+    w_old·P(last step's f, M) + w_new·P(this step's f, M), with P = contact_power at the particle's present v and L
+    (w = ½Δt of each step: each step's work with the mean of the velocities before and after it).
     """
     p = wp.tid()
     zero = wp.float64(0.0)
@@ -119,6 +132,8 @@ def eval_particle_edge_contact(
     xp = x_p[p]
     vp = v_p[p]
     mp = m_p[p]
+    Lp = grad_v[p]
+    work = w_old * contact_power(f_p[p], fm_p[p], vp, Lp)          # the last step's forces, their second half
     rp = wp.min(wp.float64(0.5) * wp.sqrt(vol_p[p]), r_max)
     rc = rp + preload * pressure_offset(p_p[p], rp, kc)
     stored = wp.float64(0.0)
@@ -170,7 +185,7 @@ def eval_particle_edge_contact(
             vc = wa * v_rock[ia] + bxi * v_rock[ib]
             cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
             arm = -surface * rp * bn                       # contact point (disk surface) − particle centre [m]
-            vrel = vp + grad_v[p] * arm - vc               # gas velocity at the contact point − wall velocity
+            vrel = vp + Lp * arm - vc                      # gas velocity at the contact point − wall velocity
             # initial overlap δ₀ (ignored part of the overlap): kept from the last step's contact with element e, else
             # what a new contact cannot explain. The deepest feature of an element (edge or vertex bk) can change,
             # e.g. for a particle an element rotated over; δ₀ belonged to the old feature, so it is re-based to keep
@@ -204,6 +219,9 @@ def eval_particle_edge_contact(
             ncon = ncon + 1
     f_p[p] = fsum
     fm_p[p] = msum
+    work = work + w_new * contact_power(fsum, msum, vp, Lp)         # this step's forces, their first half
+    if work != zero:
+        wp.atomic_add(acc, ACC_ABSORBED, -work)
     if ncon > 0:
         wp.atomic_add(acc, ACC_STORED, stored)
         wp.atomic_add(acc, ACC_CONTACTS, wp.float64(ncon))
@@ -224,26 +242,44 @@ def accumulate_gas_contact_work(
     p = wp.tid()
     if active[p] == 0:
         return
-    f = f_p[p]
-    M = fm_p[p]
-    L = grad_v[p]
-    pw = wp.dot(f, v_p[p]) + M[0, 0] * L[0, 0] + M[0, 1] * L[0, 1] + M[1, 0] * L[1, 0] + M[1, 1] * L[1, 1]
+    pw = contact_power(f_p[p], fm_p[p], v_p[p], grad_v[p])
     if pw != wp.float64(0.0):
         wp.atomic_add(acc, ACC_ABSORBED, -w * pw)
 
 
 @wp.kernel
-def accumulate_rock_contact_work(
+def account_rock_work_and_clear(
     f_react: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
     w: wp.float64,
     acc: wp.array(dtype=wp.float64),
 ):
-    """acc[ABSORBED] −= w·f·v [J/m]: work the contact reactions f [N/m] do on rock nodes moving at v [m/s] over w [s]."""
+    """acc[ABSORBED] −= w·f·v for the last step's reactions f [N/m] at the rock's present velocities v [m/s] (their
+    second half, w = ½Δt [s]), then f_react = 0 for this step's."""
     i = wp.tid()
     f = f_react[i]
     if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
-        wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(f, v[i]))
+        if w != wp.float64(0.0):
+            wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(f, v[i]))
+        f_react[i] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
+
+
+@wp.kernel
+def add_reactions_with_work(
+    f: wp.array(dtype=wp.vec2d),
+    f_react: wp.array(dtype=wp.vec2d),
+    v: wp.array(dtype=wp.vec2d),
+    w: wp.float64,
+    acc: wp.array(dtype=wp.float64),
+):
+    """f += f_react [N/m] (the gas loads on the rock nodes, after the rock's own forces) and acc[ABSORBED] −= w·f·v,
+    their work at the velocities v [m/s] before the step over w = ½Δt [s] (the first half)."""
+    i = wp.tid()
+    a = f_react[i]
+    if a[0] != wp.float64(0.0) or a[1] != wp.float64(0.0):
+        f[i] = f[i] + a
+        if w != wp.float64(0.0):
+            wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(a, v[i]))
 
 
 @wp.kernel

@@ -170,8 +170,9 @@ def update_crack_cells(cells: CrackCells, gas: CrackGasState, prm: CrackGasParam
     """Volume, openings, pressure and face forces of each wet cell; the gas pays the forces' work.
 
     Work: ½dt_prev·Σ f_old·v for the last step's forces (second half) and ½dt·Σ f_new·v for this step's (first
-    half), both with the present velocities v^{n−½}, as the particle–edge contact does (coupler._account_work):
-    the mean of the velocities before and after a step, the work the central-difference update receives.
+    half), both with the present velocities v^{n−½}, as the particle–edge contact does
+    (coupler.GasRockCoupler.energies): the mean of the velocities before and after a step, the work the
+    central-difference update receives.
     """
     q = wp.tid()
     if pair_mode[2 * q] == 0 or pair_mode[2 * q + 1] == 0 or gas.wet[q] == 2:
