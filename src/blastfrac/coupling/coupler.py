@@ -156,7 +156,6 @@ class GasRockCoupler:
         w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
         self._launch(account_rock_work_and_clear, dim=m.node_count, inputs=[self.f_react, state.v, w_old, self.acc],
                      device=m.device)
-        self._launch(_reset_step_acc, dim=1, inputs=[], outputs=[self.acc], device=m.device)
         self._dt_work = dt
         self._w_react = 0.5 * dt                          # add_reactions books the first half of this step's
         if self.n_exposed == 0:
@@ -196,9 +195,3 @@ class GasRockCoupler:
         a = self.acc.numpy()
         return {"contact_energy": float(a[ACC_ABSORBED]), "contact_penalty": float(a[ACC_STORED]),
                 "contacts": int(a[ACC_CONTACTS])}
-
-
-@wp.kernel
-def _reset_step_acc(acc: wp.array(dtype=wp.float64)):
-    acc[ACC_STORED] = wp.float64(0.0)
-    acc[ACC_CONTACTS] = wp.float64(0.0)

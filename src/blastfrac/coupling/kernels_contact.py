@@ -255,8 +255,12 @@ def account_rock_work_and_clear(
     acc: wp.array(dtype=wp.float64),
 ):
     """acc[ABSORBED] −= w·f·v for the last step's reactions f [N/m] at the rock's present velocities v [m/s] (their
-    second half, w = ½Δt [s]), then f_react = 0 for this step's."""
+    second half, w = ½Δt [s]), then f_react = 0 for this step's; and the per-step books acc[STORED] and
+    acc[CONTACTS] start again from 0 (thread 0: the contact kernel fills them after this one)."""
     i = wp.tid()
+    if i == 0:
+        acc[ACC_STORED] = wp.float64(0.0)
+        acc[ACC_CONTACTS] = wp.float64(0.0)
     f = f_react[i]
     if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
         if w != wp.float64(0.0):

@@ -1,4 +1,6 @@
-"""Detonation-products state update (METHOD §2.3, §2.5, §2.6): q, JWL energy/pressure, c, stress."""
+"""Detonation-products state update (METHOD §2.3–2.6): the burn fraction (the programmed-burn law of
+:func:`blastfrac.mpm.burn.burn_fraction`), q, JWL energy/pressure, c, stress; one kernel, one pass over the
+points (the burn was a kernel of its own, whose launch and pass over the points cost more than its law)."""
 
 from __future__ import annotations
 
@@ -7,6 +9,7 @@ import warp as wp
 from blastfrac.materials.artificial_viscosity import bulk_viscosity  # noqa: F401 (shared with the rock)
 from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq
 from blastfrac.mpm.bodies import MAT_GAS
+from blastfrac.mpm.burn import burn_fraction
 
 F64 = wp.float64
 
@@ -20,7 +23,11 @@ def update_jwl_state(
     vol_prev: wp.array(dtype=wp.float64),
     rho: wp.array(dtype=wp.float64),
     grad_v: wp.array(dtype=wp.mat22d),
-    burn: wp.array(dtype=wp.float64),
+    light_time: wp.array(dtype=wp.float64),
+    t: wp.float64,
+    p_cj: wp.float64,
+    width: wp.float64,
+    mode: int,
     rho0: wp.float64,
     D: wp.float64,
     A: wp.float64,
@@ -31,19 +38,22 @@ def update_jwl_state(
     q1: wp.float64,
     q2: wp.float64,
     v_max: wp.float64,
+    burn: wp.array(dtype=wp.float64),
     ie: wp.array(dtype=wp.float64),
     pres: wp.array(dtype=wp.float64),
     q: wp.array(dtype=wp.float64),
     cs: wp.array(dtype=wp.float64),
     stress: wp.array(dtype=wp.mat22d),
 ):
-    """Advance q, p [Pa], ie [J/m], c [m/s] and sigma = -(p + q) I of each products particle (kind MAT_GAS;
-    elastic points are left alone)."""
+    """Advance the burn fraction at the end-of-step time t [s] (never decreasing), then q, p [Pa], ie [J/m],
+    c [m/s] and sigma = -(p + q) I of each products particle (kind MAT_GAS; elastic points keep burn = 0 and are
+    left alone)."""
     p = wp.tid()
     if active[p] == 0 or kind[p] != MAT_GAS:
         return
     v0 = vol0[p]
     V = vol[p] / v0
+    burn[p] = burn_fraction(burn[p], t, light_time[p], V, wp.sqrt(v0), D, rho0, p_cj, width, mode)
     L = grad_v[p]
     trD = L[0, 0] + L[1, 1]
     l = wp.sqrt(vol[p])

@@ -41,7 +41,6 @@ from blastfrac.mpm.bodies import body_material, point_materials
 from blastfrac.mpm.burn import BURN_MODES
 from blastfrac.mpm.initiation import body_lighting_times
 from blastfrac.mpm.grid import BOX_STEPS, Grid, GridSpec
-from blastfrac.mpm.kernels_burn import update_burn
 from blastfrac.mpm.kernels_eos import update_jwl_state
 from blastfrac.mpm.kernels_g2p import g2p_velocity, g2p_velocity_apic, particle_extent, update_particle_kinematics
 from blastfrac.mpm.kernels_grid import (
@@ -550,20 +549,13 @@ class MPMSolver:
             return
         P, o = self.material, self.opts
         self._launch(
-            update_burn,
-            dim=self.n,
-            inputs=[self.active, self.mat_kind, self.light_time, self.vol, self.vol0, F64(t + dt), F64(P.D), F64(P.rho0), F64(self.p_cj),
-                    F64(o.burn_width), self.burn_mode],
-            outputs=[self.burn],
-            device=d,
-        )
-        self._launch(
             update_jwl_state,
             dim=self.n,
-            inputs=[self.active, self.mat_kind, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v, self.burn,
+            inputs=[self.active, self.mat_kind, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v,
+                    self.light_time, F64(t + dt), F64(self.p_cj), F64(o.burn_width), self.burn_mode,
                     F64(P.rho0), F64(P.D),
                     F64(P.A), F64(P.B), F64(P.R1), F64(P.R2), F64(P.omega), F64(o.q1), F64(o.q2), F64(o.v_max)],
-            outputs=[self.ie, self.p, self.q, self.cs, self.stress],
+            outputs=[self.burn, self.ie, self.p, self.q, self.cs, self.stress],
             device=d,
         )
 
