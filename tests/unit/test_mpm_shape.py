@@ -86,7 +86,7 @@ def test_p2g_conserves_mass_momentum_and_reproduces_linear_velocity():
     s.grid.vel.assign(pos @ G.T + [1.0, -2.0])
     dead = wp.zeros(1, dtype=wp.int32)
     wp.launch(update_particle_kinematics, dim=500,
-              inputs=[s.active, s.mass, s.grid.vel, s.v_pic, *s._geo_f(), wp.float64(1e-9)],
+              inputs=[s.active, s.mass, s.grid.vel, s.v_pic, s.geo, wp.float64(1e-9)],
               outputs=[s.x, s.vol, s.vol_prev, s.rho, s.grad_v, dead, s.grid.extent])
     np.testing.assert_allclose(s.grad_v.numpy(), np.broadcast_to(G, (500, 2, 2)), atol=1e-10)
     np.testing.assert_allclose(s.vol.numpy() / s.vol_prev.numpy(), np.linalg.det(np.eye(2) + 1e-9 * G), rtol=1e-14)

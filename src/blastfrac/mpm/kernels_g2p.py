@@ -7,7 +7,7 @@ import warp as wp
 
 from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.kernels_p2g import particle_stencil
-from blastfrac.mpm.shape import wrap_index
+from blastfrac.mpm.shape import GridGeometry, wrap_index
 
 F64 = wp.float64
 
@@ -31,15 +31,7 @@ def g2p_velocity(
     active: wp.array(dtype=wp.int32),
     g_vel: wp.array(dtype=wp.vec2d),
     g_dvel: wp.array(dtype=wp.vec2d),
-    x0: wp.float64,
-    y0: wp.float64,
-    inv_h: wp.float64,
-    nx: int,
-    ny: int,
-    px: int,
-    py: int,
-    kind: int,
-    l: wp.float64,
+    geo: GridGeometry,
     flip: wp.float64,
     heating: int,
     mass: wp.array(dtype=wp.float64),
@@ -56,13 +48,13 @@ def g2p_velocity(
     p = wp.tid()
     if active[p] == 0:
         return
-    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
     vp = wp.vec2d()
     dv = wp.vec2d()
     for i in range(3):
-        ii = wrap_index(bx + i, nx, px)
+        ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
-            n = wrap_index(by + j, ny, py) * nx + ii
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
             N = wx[i] * wy[j]
             vp += N * g_vel[n]
             dv += N * g_dvel[n]
@@ -79,15 +71,7 @@ def g2p_velocity_apic(
     x: wp.array(dtype=wp.vec2d),
     active: wp.array(dtype=wp.int32),
     g_vel: wp.array(dtype=wp.vec2d),
-    x0: wp.float64,
-    y0: wp.float64,
-    inv_h: wp.float64,
-    nx: int,
-    ny: int,
-    px: int,
-    py: int,
-    kind: int,
-    l: wp.float64,
+    geo: GridGeometry,
     vol: wp.array(dtype=wp.float64),
     vol0: wp.array(dtype=wp.float64),
     v_max: wp.float64,
@@ -105,16 +89,16 @@ def g2p_velocity_apic(
     p = wp.tid()
     if active[p] == 0:
         return
-    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
-    h = F64(1.0) / inv_h
-    fx = (x[p][0] - x0) * inv_h
-    fy = (x[p][1] - y0) * inv_h
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
+    h = F64(1.0) / geo.inv_h
+    fx = (x[p][0] - geo.x0) * geo.inv_h
+    fy = (x[p][1] - geo.y0) * geo.inv_h
     vp = wp.vec2d()
     Bm = wp.mat22d()
     for i in range(3):
-        ii = wrap_index(bx + i, nx, px)
+        ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
-            n = wrap_index(by + j, ny, py) * nx + ii
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
             N = wx[i] * wy[j]
             dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
             vI = g_vel[n]
@@ -144,15 +128,7 @@ def update_particle_kinematics(
     mass: wp.array(dtype=wp.float64),
     g_vel: wp.array(dtype=wp.vec2d),
     v_pic: wp.array(dtype=wp.vec2d),
-    x0: wp.float64,
-    y0: wp.float64,
-    inv_h: wp.float64,
-    nx: int,
-    ny: int,
-    px: int,
-    py: int,
-    kind: int,
-    l: wp.float64,
+    geo: GridGeometry,
     dt: wp.float64,
     x: wp.array(dtype=wp.vec2d),
     vol: wp.array(dtype=wp.float64),
@@ -171,13 +147,13 @@ def update_particle_kinematics(
     p = wp.tid()
     if active[p] == 0:
         return
-    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
     L = wp.mat22d()
     for i in range(3):
-        ii = wrap_index(bx + i, nx, px)
+        ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
-            n = wrap_index(by + j, ny, py) * nx + ii
-            grad = wp.vec2d(dwx[i] * wy[j] * inv_h, wx[i] * dwy[j] * inv_h)
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
+            grad = wp.vec2d(dwx[i] * wy[j] * geo.inv_h, wx[i] * dwy[j] * geo.inv_h)
             L += wp.outer(g_vel[n], grad)
     grad_v[p] = L
     J = wp.determinant(wp.identity(n=2, dtype=wp.float64) + dt * L)
@@ -185,29 +161,29 @@ def update_particle_kinematics(
     vol[p] = vol[p] * J
     rho[p] = mass[p] / vol[p]
     xn = x[p] + dt * v_pic[p]
-    fx = (xn[0] - x0) * inv_h
-    fy = (xn[1] - y0) * inv_h
-    if px != 0:
-        fx = fx - wp.floor(fx / wp.float64(nx)) * wp.float64(nx)
-        xn[0] = x0 + fx / inv_h
-    if py != 0:
-        fy = fy - wp.floor(fy / wp.float64(ny)) * wp.float64(ny)
-        xn[1] = y0 + fy / inv_h
+    fx = (xn[0] - geo.x0) * geo.inv_h
+    fy = (xn[1] - geo.y0) * geo.inv_h
+    if geo.px != 0:
+        fx = fx - wp.floor(fx / wp.float64(geo.nx)) * wp.float64(geo.nx)
+        xn[0] = geo.x0 + fx / geo.inv_h
+    if geo.py != 0:
+        fy = fy - wp.floor(fy / wp.float64(geo.ny)) * wp.float64(geo.ny)
+        xn[1] = geo.y0 + fy / geo.inv_h
     x[p] = xn
     out = 0
-    if px == 0:
+    if geo.px == 0:
         b = int(wp.floor(fx - F64(0.5)))
-        if b < 0 or b + 2 > nx - 1:
+        if b < 0 or b + 2 > geo.nx - 1:
             out = 1
-    if py == 0:
+    if geo.py == 0:
         b = int(wp.floor(fy - F64(0.5)))
-        if b < 0 or b + 2 > ny - 1:
+        if b < 0 or b + 2 > geo.ny - 1:
             out = 1
     if out != 0 or J <= F64(0.0):
         active[p] = 0
         wp.atomic_add(deactivated, 0, 1)
         return
-    accumulate_extent(xn, x0, y0, inv_h, extent)
+    accumulate_extent(xn, geo.x0, geo.y0, geo.inv_h, extent)
 
 
 @wp.kernel

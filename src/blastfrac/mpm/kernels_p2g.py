@@ -11,7 +11,7 @@ from __future__ import annotations
 import warp as wp
 
 from blastfrac.mpm.apic import affine_from_moments, affine_inertia
-from blastfrac.mpm.shape import stencil_1d, wrap_index
+from blastfrac.mpm.shape import GridGeometry, stencil_1d, wrap_index
 
 F64 = wp.float64
 
@@ -35,15 +35,7 @@ def p2g(
     f_ext: wp.array(dtype=wp.vec2d),
     f_ext_moment: wp.array(dtype=wp.mat22d),
     active: wp.array(dtype=wp.int32),
-    x0: wp.float64,
-    y0: wp.float64,
-    inv_h: wp.float64,
-    nx: int,
-    ny: int,
-    px: int,
-    py: int,
-    kind: int,
-    l: wp.float64,
+    geo: GridGeometry,
     affine: int,
     g_mass: wp.array(dtype=wp.float64),
     g_mom: wp.array(dtype=wp.vec2d),
@@ -58,24 +50,24 @@ def p2g(
     p = wp.tid()
     if active[p] == 0:
         return
-    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
     m = mass[p]
     mv = m * v[p]
     vs = vol[p] * stress[p]
     fe = f_ext[p]
     ms = f_ext_moment[p] - vs
-    h = F64(1.0) / inv_h
-    fx = (x[p][0] - x0) * inv_h
-    fy = (x[p][1] - y0) * inv_h
+    h = F64(1.0) / geo.inv_h
+    fx = (x[p][0] - geo.x0) * geo.inv_h
+    fy = (x[p][1] - geo.y0) * geo.inv_h
     Cp = wp.mat22d()
     if affine != 0:
         Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
     for i in range(3):
-        ii = wrap_index(bx + i, nx, px)
+        ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
-            n = wrap_index(by + j, ny, py) * nx + ii
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
             N = wx[i] * wy[j]
-            grad = wp.vec2d(dwx[i] * wy[j] * inv_h, wx[i] * dwy[j] * inv_h)
+            grad = wp.vec2d(dwx[i] * wy[j] * geo.inv_h, wx[i] * dwy[j] * geo.inv_h)
             wp.atomic_add(g_mass, n, N * m)
             if affine != 0:
                 dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)
@@ -92,15 +84,7 @@ def p2g_momentum(
     b_aff: wp.array(dtype=wp.mat22d),
     mass: wp.array(dtype=wp.float64),
     active: wp.array(dtype=wp.int32),
-    x0: wp.float64,
-    y0: wp.float64,
-    inv_h: wp.float64,
-    nx: int,
-    ny: int,
-    px: int,
-    py: int,
-    kind: int,
-    l: wp.float64,
+    geo: GridGeometry,
     affine: int,
     g_mom: wp.array(dtype=wp.vec2d),
 ):
@@ -109,19 +93,19 @@ def p2g_momentum(
     p = wp.tid()
     if active[p] == 0:
         return
-    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], x0, y0, inv_h, kind, l)
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
     m = mass[p]
     mv = m * v[p]
-    h = F64(1.0) / inv_h
-    fx = (x[p][0] - x0) * inv_h
-    fy = (x[p][1] - y0) * inv_h
+    h = F64(1.0) / geo.inv_h
+    fx = (x[p][0] - geo.x0) * geo.inv_h
+    fy = (x[p][1] - geo.y0) * geo.inv_h
     Cp = wp.mat22d()
     if affine != 0:
         Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
     for i in range(3):
-        ii = wrap_index(bx + i, nx, px)
+        ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
-            n = wrap_index(by + j, ny, py) * nx + ii
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
             N = wx[i] * wy[j]
             if affine != 0:
                 dx = wp.vec2d((F64(bx + i) - fx) * h, (F64(by + j) - fy) * h)

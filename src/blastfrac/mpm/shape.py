@@ -29,6 +29,30 @@ SHAPE_UGIMP = 1
 SHAPE_IDS = {"bspline2": SHAPE_BSPLINE2, "ugimp": SHAPE_UGIMP}
 
 
+@wp.struct
+class GridGeometry:
+    """The background grid as the transfer kernels see it: origin (x0, y0) [m], 1/h [1/m], nodes per side,
+    periodicity per axis (1: periodic), shape function (SHAPE_*) and uGIMP's l_p/h [-]."""
+
+    x0: wp.float64
+    y0: wp.float64
+    inv_h: wp.float64
+    nx: int
+    ny: int
+    px: int
+    py: int
+    kind: int
+    l: wp.float64
+
+
+def grid_geometry(x0: float, y0: float, inv_h: float, nx: int, ny: int, px: int, py: int, kind: int,
+                  l: float) -> GridGeometry:
+    """A GridGeometry from its values (MPMSolver builds one per run)."""
+    g = GridGeometry()
+    g.x0, g.y0, g.inv_h, g.nx, g.ny, g.px, g.py, g.kind, g.l = x0, y0, inv_h, nx, ny, px, py, kind, l
+    return g
+
+
 @wp.func
 def shape_1d(r: wp.float64, kind: int, l: wp.float64):
     """1D weight S(r) and dS/dr at r = (x_p - x_I)/h; l = l_p/h for uGIMP. Returns vec2d(S, dS/dr)."""

@@ -54,7 +54,7 @@ from blastfrac.mpm.kernels_misc import max_signal_speed
 from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
 from blastfrac.mpm.kernels_solid import update_elastic_state
 from blastfrac.mpm.seeding import charge_area_centroid, charge_bbox, seed_charges
-from blastfrac.mpm.shape import SHAPE_IDS, shape_1d_np
+from blastfrac.mpm.shape import SHAPE_IDS, grid_geometry, shape_1d_np
 
 F64 = np.float64
 
@@ -362,6 +362,7 @@ class MPMSolver:
             self.shape_kind,
             self.shape_l,
         )
+        self.geo = grid_geometry(*self._geo)       # the same, as the transfer kernels take it
 
     def set_gas_state(self, rho: np.ndarray, p: np.ndarray, v: np.ndarray | None = None,
                       mask: np.ndarray | None = None) -> None:
@@ -457,7 +458,7 @@ class MPMSolver:
             p2g,
             dim=self.n,
             inputs=[self.x, self.v, self.b_aff, self.mass, self.vol, self.stress, self.f_ext_p, self.f_ext_moment, self.active,
-                    *self._geo_f(), int(self.apic)],
+                    self.geo, int(self.apic)],
             outputs=[g.mass, g.mom, g.force],
             device=self.device,
         )
@@ -493,24 +494,24 @@ class MPMSolver:
 
     def to_particles(self, dt: float) -> None:
         """G2P (FLIP/PIC or APIC), MUSL remap (with the affine term), velocity gradient, volume and position update."""
-        g, geo, d = self.grid, self._geo_f(), self.device
+        g, geo, d = self.grid, self.geo, self.device
         if self.apic:
             v_max = self.opts.v_max if self.is_jwl else float("inf")
             self._launch(g2p_velocity_apic, dim=self.n,
-                         inputs=[self.x, self.active, g.vel, *geo, self.vol, self.vol0, F64(v_max)],
+                         inputs=[self.x, self.active, g.vel, geo, self.vol, self.vol0, F64(v_max)],
                          outputs=[self.v, self.v_pic, self.b_aff], device=d)
         else:
             self._launch(
                 g2p_velocity,
                 dim=self.n,
-                inputs=[self.x, self.active, g.vel, g.dvel, *geo, F64(self.opts.flip),
+                inputs=[self.x, self.active, g.vel, g.dvel, geo, F64(self.opts.flip),
                         int(bool(self.opts.blend_heating) and self.opts.flip < 1.0), self.mass, self.mat_kind],
                 outputs=[self.v, self.v_pic, self.ie],
                 device=d,
             )
         self._launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 0],
                      outputs=[g.mass, g.mom, g.force], device=d, key="remap")
-        self._launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, *geo, int(self.apic)],
+        self._launch(p2g_momentum, dim=self.n, inputs=[self.x, self.v, self.b_aff, self.mass, self.active, geo, int(self.apic)],
                      outputs=[g.mom], device=d)
         self._fold_walls(0)
         self._launch(
@@ -524,7 +525,7 @@ class MPMSolver:
         self._launch(
             update_particle_kinematics,
             dim=self.n,
-            inputs=[self.active, self.mass, g.vel, self.v_pic, *geo, F64(dt)],
+            inputs=[self.active, self.mass, g.vel, self.v_pic, geo, F64(dt)],
             outputs=[self.x, self.vol, self.vol_prev, self.rho, self.grad_v, self._deactivated, g.extent],
             device=d,
         )
@@ -565,10 +566,6 @@ class MPMSolver:
         self.update_grid(dt)
         self.to_particles(dt)
         self.update_eos(dt, t)
-
-    def _geo_f(self):
-        x0, y0, ih, nx, ny, px, py, k, l = self._geo
-        return [F64(x0), F64(y0), F64(ih), nx, ny, px, py, k, F64(l)]
 
     # ------------------------------------------------------------------ diagnostics
     def stable_dt(self) -> float:
