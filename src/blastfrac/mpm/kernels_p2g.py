@@ -24,6 +24,20 @@ def particle_stencil(x: wp.vec2d, x0: wp.float64, y0: wp.float64, inv_h: wp.floa
     return bx, by, wx, dwx, wy, dwy
 
 
+@wp.func
+def particle_affine(affine: int, B: wp.mat22d, xp: wp.vec2d, geo: GridGeometry, bx: int, by: int, wx: wp.vec3d,
+                    wy: wp.vec3d):
+    """(C_p = B_p D_p⁻¹ [1/s], 0 unless ``affine``; the particle's fractional grid coordinates fx, fy; h [m]) for
+    the momentum's affine term N m_p C_p (x_I − x_p), x_I − x_p = ((b + k) − f)·h."""
+    h = F64(1.0) / geo.inv_h
+    fx = (xp[0] - geo.x0) * geo.inv_h
+    fy = (xp[1] - geo.y0) * geo.inv_h
+    Cp = wp.mat22d()
+    if affine != 0:
+        Cp = affine_from_moments(B, affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
+    return Cp, fx, fy, h
+
+
 @wp.kernel
 def p2g(
     x: wp.array(dtype=wp.vec2d),
@@ -56,12 +70,7 @@ def p2g(
     vs = vol[p] * stress[p]
     fe = f_ext[p]
     ms = f_ext_moment[p] - vs
-    h = F64(1.0) / geo.inv_h
-    fx = (x[p][0] - geo.x0) * geo.inv_h
-    fy = (x[p][1] - geo.y0) * geo.inv_h
-    Cp = wp.mat22d()
-    if affine != 0:
-        Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
+    Cp, fx, fy, h = particle_affine(affine, b_aff[p], x[p], geo, bx, by, wx, wy)
     for i in range(3):
         ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
@@ -96,12 +105,7 @@ def p2g_momentum(
     bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
     m = mass[p]
     mv = m * v[p]
-    h = F64(1.0) / geo.inv_h
-    fx = (x[p][0] - geo.x0) * geo.inv_h
-    fy = (x[p][1] - geo.y0) * geo.inv_h
-    Cp = wp.mat22d()
-    if affine != 0:
-        Cp = affine_from_moments(b_aff[p], affine_inertia(wx, wy, F64(bx) - fx, F64(by) - fy, h))
+    Cp, fx, fy, h = particle_affine(affine, b_aff[p], x[p], geo, bx, by, wx, wy)
     for i in range(3):
         ii = wrap_index(bx + i, geo.nx, geo.px)
         for j in range(3):
