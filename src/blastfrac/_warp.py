@@ -67,9 +67,9 @@ _RECORD_LOCK = threading.Lock()
 class Launcher:
     """``wp.launch`` through recorded launches (``wp.launch(..., record_cmd=True)``), one per kernel and call site.
 
-    Packing a launch's arguments costs Warp ~1.5 µs per argument in Python at every call (a 29-argument spring
-    launch: 50 µs, against 7 µs to replay it); a replay only sets the scalar arguments that changed and the launch
-    size. Called like ``wp.launch(kernel, dim, inputs=..., outputs=..., device=...)``; ``key`` tells apart two call
+    Packing a launch's arguments costs Warp ~1.5 µs per argument in Python at every call (a 29-argument launch:
+    50 µs, against 7 µs to replay it); a replay only sets the scalar arguments that changed and the launch size.
+    Called like ``wp.launch(kernel, dim, inputs=..., outputs=..., device=...)``; ``key`` tells apart two call
     sites of one kernel with different arrays (each keeps its own record). A launch is recorded again whenever one
     of its arrays is another object than at the last call (another State, a reallocated array), and a struct
     argument that is another object is packed again. The same struct object is not: Warp packs a struct as a
@@ -77,21 +77,17 @@ class Launcher:
     and every launch reads, so a replay sees fields set since (tests/unit/test_launcher.py checks this against
     plain launches, so a Warp release that copied the record instead would fail there, not silently). A replay
     thus always runs on what it is given; the same arguments give the same launch, bit for bit.
-    ``Launcher(record=False)`` calls ``wp.launch`` every time (the reference of the tests). ``records`` counts the
-    recordings (a count that keeps growing means a call site alternates between arrays and needs a key),
-    ``replays`` the launches replayed (benchmarks count them beside the plain ``wp.launch`` calls)."""
+    ``records`` counts the recordings (a count that keeps growing means a call site alternates between arrays
+    and needs a key), ``replays`` the launches replayed (benchmarks count them beside the plain ``wp.launch``
+    calls)."""
 
-    def __init__(self, record: bool = True):
-        self.record = bool(record)
+    def __init__(self):
         self.records = 0
         self.replays = 0
         self._cmds: dict = {}
 
     def __call__(self, kernel, dim, inputs=(), outputs=(), device=None, key=None) -> None:
         params = [*inputs, *(outputs or ())]
-        if not self.record:
-            wp.launch(kernel, dim=dim, inputs=params, device=device)
-            return
         if dim == 0:
             return                                   # wp.launch does nothing for an empty launch either
         rec = self._cmds.get((kernel, key))

@@ -104,7 +104,8 @@ slower than the code before the cache, a reference only). Demo end state (3,966 
 broken, benchmarks/contact_cache.py, CPU): the rock step costs ×2.4 the intact one (×3.6–4.1 before the
 cache); open nodes searching their own vertex through the fan and the hash rebuilt on displacement took
 0.80 → 0.65 ms intact and 1.95 → 1.56 ms cracked. What is left is mostly the contact of ~1,300 held nodes in
-contact (~0.3 ms) and the corner test of ~6,500 held ones in the listing pass (~0.25 ms). Before the cache, on 59k elements (CPU): ×1.35 per step on nearly intact rock,
+contact (~0.3 ms) and the corner test of ~6,500 held ones in the listing pass (~0.25 ms). Before the cache, on
+59k elements (CPU): ×1.35 per step on nearly intact rock,
 ×2.9 with 17 % of the springs broken (×1.4 with ``held_faces`` off, at the price of 0.3·h overlaps in the
 crushed zone).
 
@@ -298,15 +299,20 @@ class BlockContact:
                                                         self.contact_p, self.contact_kc)
         hist.loss_acc = self.loss_acc
         self.s_prm = ContactParams()
+        self._prm_values = None
 
     def _params(self) -> ContactParams:
-        """The scheme's scalars as they are now (tests and benchmarks change held_faces and near_window)."""
-        prm = self.s_prm
-        prm.kn_area, prm.mu_f, prm.search_radius = self.kn_area, self.mu_f, self.radius
-        prm.max_depth, prm.touch_tol, prm.wake_dist = 0.5 * self.h_min, 1e-9 * self.h_min, self.h_min
-        prm.near_window, prm.quiet_steps = int(self.near_window), int(self.rebuild_interval)
-        prm.held_faces = int(bool(self.held_faces))
-        return prm
+        """The scheme's scalars as they are now (tests and benchmarks change held_faces and near_window); the
+        struct's fields are set only when one has changed."""
+        values = (self.kn_area, self.mu_f, self.radius, self.h_min, int(self.near_window),
+                  int(self.rebuild_interval), int(bool(self.held_faces)))
+        if values != self._prm_values:
+            prm = self.s_prm
+            prm.kn_area, prm.mu_f, prm.search_radius = self.kn_area, self.mu_f, self.radius
+            prm.max_depth, prm.touch_tol, prm.wake_dist = 0.5 * self.h_min, 1e-9 * self.h_min, self.h_min
+            prm.near_window, prm.quiet_steps, prm.held_faces = values[4], values[5], values[6]
+            self._prm_values = values
+        return self.s_prm
 
     def apply(self, state, dt: float) -> None:
         """Add the contact forces of the current configuration to state.f; dt [s] drives the friction."""
