@@ -78,7 +78,7 @@ def emulsion_at_cj() -> dict:
 
 
 def scenario(cells: int, ppc: int = 2, end: float = END, rock_h: float | None = None,
-             flip: float | None = None, d_cj: bool = False) -> dict:
+             flip: float | None = None, d_cj: bool = False, current: bool = False) -> dict:
     """The study's scenario at ``cells`` MPM cells across the charge diameter (a plain dict)."""
     h = 2 * R / cells
     mons = []
@@ -104,10 +104,13 @@ def scenario(cells: int, ppc: int = 2, end: float = END, rock_h: float | None = 
                                "bounds": [[-BOX * R, -BOX * R], [BOX * R, BOX * R]]}},
         "monitors": mons,
     }
-    # the study ran before 0.2 made 1 % PIC with heating the default: it pins the transfers it measured, pure FLIP
-    # (the default series) and the plain 1 % PIC blend (flip99), so that its tables stay reproducible
-    d["explosive"]["flip"] = 1.0 if flip is None else flip
-    d["explosive"]["blend_heating"] = False
+    # the first series ran before 0.2's gas defaults (1 % PIC with heating, q2 = 2 on the products' own sound
+    # speed): they pin what they measured, pure FLIP ("default" series, named so before 0.2) and the plain 1 % PIC
+    # blend (flip99), both with q2 = 0.06. The "v02" series runs the defaults as they are.
+    if not current:
+        d["explosive"]["flip"] = 1.0 if flip is None else flip
+        d["explosive"]["blend_heating"] = False
+        d["explosive"]["q2"] = 0.06
     if d_cj:
         del d["explosive"]["name"]
         d["explosive"]["constants"] = emulsion_at_cj()
@@ -120,11 +123,14 @@ for _n in LEVELS[:-1]:                                            # 1 % PIC in t
     CASES[f"n{_n}_flip99"] = {"cells": _n, "flip": 0.99, "series": "flip99"}
 for _n in LEVELS[:-1]:                                            # lighting at the JWL's own CJ speed
     CASES[f"n{_n}_dcj"] = {"cells": _n, "d_cj": True, "series": "dcj", "end": 12e-6}
+for _n in LEVELS[:-1]:                                            # the defaults of 0.2 (not pinned)
+    CASES[f"n{_n}_v02"] = {"cells": _n, "current": True, "series": "v02"}
 CASES["n10_ppc3"] = {"cells": 10, "ppc": 3, "series": "variant", "base": "n10"}
 CASES["n20_ppc3"] = {"cells": 20, "ppc": 3, "series": "variant", "base": "n20"}
 CASES["n20_rock40"] = {"cells": 20, "rock_h": 2 * R / 40, "series": "variant", "base": "n20"}   # rock of level 40
 REFERENCE_CELLS = (80, 40)   # reference levels: to 10 µs, and for 10–20 µs (80 cells drifts after 10 µs, README)
-SERIES_LABEL = {"default": "default (pure FLIP)", "flip99": "explosive.flip = 0.99",
+SERIES_LABEL = {"default": "pure FLIP, q2 = 0.06 (the defaults before 0.2)", "flip99": "explosive.flip = 0.99",
+                "v02": "the defaults of 0.2 (1 % PIC with heating, q2 = 2)",
                 "dcj": "emulsion lit at its own CJ speed (D = 5522 m/s)"}
 
 
@@ -137,7 +143,7 @@ def run_case(name: str, out: Path, end: float | None = None) -> dict:
     spec = CASES[name]
     end = end or spec.get("end", END)
     sc = scenario_from_dict(scenario(spec["cells"], spec.get("ppc", 2), end, spec.get("rock_h"), spec.get("flip"),
-                                     spec.get("d_cj", False)))
+                                     spec.get("d_cj", False), spec.get("current", False)))
 
     class Recorder(Simulation):
         """Records the cumulative wall impulse, the hole's area and the gas's volume at every sample."""
@@ -298,7 +304,7 @@ def analyse(out: Path) -> tuple[dict, dict]:
                             "monitor_interval": MONITOR_INTERVAL},
                  "cases": {k: {kk: vv for kk, vv in v.items() if kk != "series_data"} for k, v in cases.items()},
                  "series": {}}
-    for series in ("default", "flip99", "dcj"):
+    for series in ("default", "flip99", "dcj", "v02"):
         lv = sorted((c for c in cases.values() if c.get("series") == series), key=lambda c: c["cells"])
         if not lv:
             continue

@@ -70,7 +70,7 @@ def test_p2g_conserves_mass_momentum_and_reproduces_linear_velocity():
     vol = rng.uniform(1, 2, 500) * 1e-4
     G = np.array([[0.3, -0.2], [0.5, 0.1]])
     v = x @ G.T + [1.0, -2.0]
-    s = MPMSolver.from_arrays(x, vol, spec, LinearElasticMP(1e6, 0.3, 1000.0), MPMOptions(flip=0.0), v=v)
+    s = MPMSolver.from_arrays(x, vol, spec, LinearElasticMP(1e6, 0.3, 1000.0), MPMOptions(flip_bodies=0.0), v=v)
     s.to_grid(1e-9)
     m = s.mass.numpy()
     assert abs(s.grid.mass.numpy().sum() / m.sum() - 1) < 1e-13

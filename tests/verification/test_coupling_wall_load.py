@@ -148,5 +148,7 @@ def test_former_scheme_is_caught(tmp_path):
     late = old["t"] > 2e-6
     pw, pg = old["p_wall"][late].mean(), old["p_gas"][late].mean()
     print(f"\n  former scheme: wall {pw / 1e6:.1f} MPa vs gas at the wall {pg / 1e6:.1f}, max {old['p_wall'].max() / 1e6:.1f}")
-    assert old["p_wall"].max() > 1.3 * P0
+    # each fails its check in test_wall_load_equals_gas_pressure (measured with the 0.2 gas defaults: max 1.28 p0;
+    # with pure FLIP and q2 = 0.06 it was 1.6-2 p0)
+    assert old["p_wall"].max() > 1.12 * P0
     assert pw / pg > 1.1

@@ -95,7 +95,7 @@ def test_rotating_disc_keeps_angular_momentum_with_apic_not_with_pic():
     """A rigidly spinning free disc, 100 full steps (0.5 rad): APIC keeps L to round-off, PIC loses it."""
     out = {}
     for name, transfer, flip in (("APIC", "apic", 1.0), ("PIC", "flip", 0.0), ("FLIP", "flip", 1.0)):
-        s = disc(transfer, flip=flip)
+        s = disc(transfer, flip_bodies=flip)
         L0 = particle_totals(s)[2]
         KE0 = s.energies()["kinetic"]
         L_disc = 0.5 * s.total_mass() * R**2 * OMEGA  # continuous disc of the same mass: I = M R^2 / 2

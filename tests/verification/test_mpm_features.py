@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from blastfrac.explosives.library import get_explosive
-from blastfrac.materials.jwl import V_FLOOR, JWLParams, jwl_pressure_np
+from blastfrac.materials.jwl import V_FLOOR, JWLParams, jwl_pressure_np, jwl_sound_speed_sq_np
 from blastfrac.materials.linear_elastic_mp import LinearElasticMP
 from blastfrac.mpm import GridSpec, MPMOptions, MPMSolver
 from blastfrac.mpm.grid import BC_X
@@ -79,9 +79,10 @@ def test_grid_from_scenario_several_charges_and_delayed_detonation_points():
     F = s.burn.numpy()
     r2 = np.linalg.norm(x - pts[1], axis=1)
     lit = in_s & (r2 < 0.7 * (4.8e-6 - 4e-6) * D)
-    # ahead of the front only the volumetric burn of the grid's precompression acts (it dies out within ~4 h)
+    # ahead of the front only the volumetric burn of the grid's precompression acts (it dies out within ~4 h: beyond
+    # 5 h it leaves F ~1e-4 with the default linear viscosity q2 = 2, 0 with q2 = 0.06); lit early, F would be 1
     dark = in_s & (r2 > (4.8e-6 - 4e-6) * D + 5 * h)
-    assert lit.sum() > 10 and F[lit].min() > 0.99 and dark.sum() > 50 and F[dark].max() == 0.0
+    assert lit.sum() > 10 and F[lit].min() > 0.99 and dark.sum() > 50 and F[dark].max() < 1e-3
     # the run's CJ check of this set (summary.json carries the same report)
     rep = s.cj_check()
     assert rep["name"] == "petn" and not rep["warn"] and abs(rep["D_cj"] / D - 1) < 0.005
@@ -116,7 +117,10 @@ def test_mass_cutoff_and_cfl_time_step():
     np.testing.assert_allclose(gm, m_ref, rtol=1e-12, atol=1e-30)
     below, above = (m_ref > 0) & (m_ref <= m_cut), m_ref > m_cut
     assert below.sum() >= 9 and above.sum() >= 4  # the light particle's whole stencil is under the cut-off
-    assert not gv[below].any()  # no velocity on cut-off nodes
+    # a cut-off node takes no force (no increment) but keeps its points' velocity p_I/m_I, so neither the PIC share
+    # nor the points' motion sees a node at rest there (which lost momentum at the fringe of expanding gas)
+    np.testing.assert_allclose(gv[below], v_ref[below], rtol=1e-12)
+    assert not s.grid.dvel.numpy()[below].any()
     np.testing.assert_allclose(gv[above], v_ref[above], rtol=1e-12)
 
 
@@ -129,7 +133,9 @@ def test_artificial_bulk_viscosity_and_stress():
         s = MPMSolver.from_arrays(x, vol, spec, P, opts, burn=np.ones(len(x)))
         s.grid.bc_mask.assign(np.full(spec.node_count, BC_X, dtype=np.int32))
         s.grid.bc_vel.assign(np.stack([sign * k * spec.node_positions()[:, 0], np.zeros(spec.node_count)], axis=1))
-        c_before = s.cs.numpy().copy()
+        # q's c is the products' own sound speed at the step's start (not the time step's signal speed cs)
+        c_before = np.sqrt(jwl_sound_speed_sq_np(s.vol_prev.numpy() / s.vol0.numpy(), s.ie.numpy() / s.vol0.numpy(),
+                                                 s.p.numpy(), P.rho0, P.A, P.B, P.R1, P.R2, P.omega))
         s.step(1e-9, 0.0)
         trD = np.trace(s.grad_v.numpy(), axis1=1, axis2=2)
         np.testing.assert_allclose(trD, sign * k, rtol=1e-9)
@@ -189,7 +195,7 @@ def test_flip_pic_blend():
                       for p in range(60)])
     ke = []
     for flip in (1.0, 0.3, 0.0):
-        s = MPMSolver.from_arrays(x, vol, spec, mat, MPMOptions(flip=flip, mass_cutoff=0.0), v=v)
+        s = MPMSolver.from_arrays(x, vol, spec, mat, MPMOptions(flip_bodies=flip, mass_cutoff=0.0), v=v)
         s.step(1e-6, 0.0)
         np.testing.assert_allclose(s.v.numpy(), flip * v + (1 - flip) * v_pic, rtol=1e-10, atol=1e-12)
         ke.append(s.energies()["kinetic"])

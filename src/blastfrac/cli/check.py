@@ -10,10 +10,10 @@ from .common import add_force_arg, add_scenario_args, check_output_dir, load, re
 STEPS_WARNING = 10_000_000    # check warns above this many steps to the end time
 # check warns when a charge has fewer MPM cells than this across its width (circle: 2r/h; charge_width). From the
 # study examples/charge_resolution (README.md: a 5 mm emulsion charge filling its hole in elastic Table 2 rock, 10 to
-# 160 cells across): the wall impulse over 5-10 µs (detonation and first reverberations) is off by up to 7.3 % at 10
-# cells, 3.7 % at 20 and 1.6 % at 40 against 80 cells (2.3 / 1.3 / 0.8 % with the emulsion lit at its own CJ speed);
-# the 10-20 µs impulse (quasi-static gas pressure) is within 1.5 % already at 10 cells. 20 is the coarsest level that
-# keeps the early impulse within ~3-4 % (and the later one within 1.5 %); finer than 40 cells buys no accuracy there.
+# 80 cells across), with the 0.2 gas defaults: the wall impulse over 5-10 µs (detonation and first reverberations)
+# is off by up to 3.6 % at 10 cells, 1.8 % at 20 and 1.1 % at 40 against 80 cells; the 10-20 µs impulse
+# (quasi-static gas pressure) within 1.1 % of 40 cells already at 10. 20 is the coarsest level that keeps the early
+# impulse within 2 %. (With pure FLIP and q2 = 0.06, the defaults before 0.2: 7.3 / 3.7 / 1.6 %.)
 CHARGE_CELLS_ACROSS_MIN = 20
 
 
@@ -196,6 +196,6 @@ def charge_resolution_warnings(sc) -> list[str]:
             what = "2r/h" if ch.kind == "circle" else "narrowest width/h"
             out.append(f"explosive.charges[{i}] ({ch.kind}, {w * 1e3:.4g} mm across): {cells:.3g} grid cells across "
                        f"({what}, explosive.grid.cell_size = {h * 1e3:.4g} mm), fewer than {CHARGE_CELLS_ACROSS_MIN}; "
-                       f"its wall impulse over the first 5-10 µs is then off by more than ~3 % (7 % at 10 cells, "
+                       f"its wall impulse over the first 5-10 µs is then off by more than ~2 % (3.6 % at 10 cells, "
                        f"examples/charge_resolution): cell_size <= {w / CHARGE_CELLS_ACROSS_MIN * 1e3:.3g} mm resolves it")
     return out

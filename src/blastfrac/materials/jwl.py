@@ -95,6 +95,24 @@ def jwl_sound_speed_sq(
 
 
 @wp.func
+def products_sound_speed(
+    F: wp.float64,
+    V: wp.float64,
+    E: wp.float64,
+    p: wp.float64,
+    rho0: wp.float64,
+    A: wp.float64,
+    B: wp.float64,
+    R1: wp.float64,
+    R2: wp.float64,
+    w: wp.float64,
+):
+    """Sound speed c [m/s] of partly burnt explosive, burn fraction F [-]: the pressure is F·p_JWL(V, E), so
+    c² = F·c²_JWL at (V [-], E [J/m³], p [Pa]); 0 for unburnt explosive, which carries no pressure."""
+    return wp.sqrt(F * jwl_sound_speed_sq(V, E, p, rho0, A, B, R1, R2, w))
+
+
+@wp.func
 def jwl_energy_update(
     V_new: wp.float64,
     vol_new: wp.float64,
@@ -149,6 +167,11 @@ def jwl_sound_speed_sq_np(V, E, p, rho0, A, B, R1, R2, w):
     t2 = (R2 * B * (1.0 - w / (R2 * V)) - B * w / (R2 * V * V)) * e2
     c2 = V * V / rho0 * (t1 + t2 + w * np.asarray(E) / (V * V)) + w * np.asarray(p) * V / rho0
     return np.maximum(c2, 0.0)
+
+
+def products_sound_speed_np(F, V, E, p, rho0, A, B, R1, R2, w):
+    """NumPy twin of :func:`products_sound_speed` [m/s]."""
+    return np.sqrt(np.asarray(F, dtype=np.float64) * jwl_sound_speed_sq_np(V, E, p, rho0, A, B, R1, R2, w))
 
 
 def jwl_energy_update_np(V_new, vol_new, vol_old, vol0, ie, p_old, q, F, A, B, R1, R2, w):

@@ -7,7 +7,7 @@ from __future__ import annotations
 import warp as wp
 
 from blastfrac.materials.artificial_viscosity import bulk_viscosity  # noqa: F401 (shared with the rock)
-from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq
+from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq, products_sound_speed
 from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.burn import burn_fraction
 
@@ -53,11 +53,15 @@ def update_jwl_state(
         return
     v0 = vol0[p]
     V = vol[p] / v0
+    # q's sound speed is the products' own at the start of the step, of the burnt share F (the unburnt share
+    # carries no pressure): not cs[p], the time step's signal speed, which holds q's own augmentation and the
+    # burn front's floor D(1 - F) and so made the linear term ~(1 + sqrt 2)x stronger than its Q2 said.
+    c_mix = products_sound_speed(burn[p], wp.max(vol_prev[p] / v0, F64(0.2)), ie[p] / v0, pres[p], rho0, A, B, R1, R2, w)
     burn[p] = burn_fraction(burn[p], t, light_time[p], V, wp.sqrt(v0), D, rho0, p_cj, width, mode)
     L = grad_v[p]
     trD = L[0, 0] + L[1, 1]
     l = wp.sqrt(vol[p])
-    qn = bulk_viscosity(trD, rho[p], l, cs[p], q1, q2)
+    qn = bulk_viscosity(trD, rho[p], l, c_mix, q1, q2)
     F = burn[p]
     if V > v_max:
         F = F64(0.0)

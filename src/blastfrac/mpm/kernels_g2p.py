@@ -25,6 +25,20 @@ def blend_heat_np(m, v_flip, v_new):
     return 0.5 * np.asarray(m, float) * ((v_flip * v_flip).sum(-1) - (v_new * v_new).sum(-1))
 
 
+@wp.func
+def gas_velocity(bx: int, by: int, wx: wp.vec3d, wy: wp.vec3d, geo: GridGeometry, g_vel_gas: wp.array(dtype=wp.vec2d),
+                 g_dvel: wp.array(dtype=wp.vec2d)):
+    """sum N (v_I^gas + dv_I) [m/s] over a point's stencil, v_I^gas = p_I^gas / m_I^gas before the update: the gas's
+    own updated grid velocity (equal to v_I where no body shares the node)."""
+    out = wp.vec2d()
+    for i in range(3):
+        ii = wrap_index(bx + i, geo.nx, geo.px)
+        for j in range(3):
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
+            out += (wx[i] * wy[j]) * (g_vel_gas[n] + g_dvel[n])
+    return out
+
+
 @wp.kernel
 def g2p_velocity(
     x: wp.array(dtype=wp.vec2d),
@@ -33,14 +47,22 @@ def g2p_velocity(
     g_dvel: wp.array(dtype=wp.vec2d),
     geo: GridGeometry,
     flip: wp.float64,
+    flip_bodies: wp.float64,
     heating: int,
     mass: wp.array(dtype=wp.float64),
     mat_kind: wp.array(dtype=wp.int32),
+    own: int,
+    g_vel_gas: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
     v_pic: wp.array(dtype=wp.vec2d),
     ie: wp.array(dtype=wp.float64),
 ):
-    """v_p = flip (v_p + sum N dv_I) + (1 - flip) sum N v_I; v_pic = sum N v_I moves the particle [m/s].
+    """v_p = f (v_p + sum N dv_I) + (1 - f) sum N v_I, f = ``flip`` for gas points and ``flip_bodies`` for the
+    points of elastic bodies; v_pic = sum N v_I moves the particle [m/s].
+
+    With ``own`` (gas and elastic bodies share the grid, flip < 1) a gas point's PIC share aims at the gas's own
+    velocity, sum N (v_I^gas + dv_I) (:func:`gas_velocity`, :func:`~blastfrac.mpm.kernels_p2g.p2g_gas`): over the gas,
+    m_p times it is the gas's FLIP momentum, so the blend moves no momentum between the gas and the bodies.
 
     With ``heating`` (``explosive.blend_heating``) a gas point's internal energy ie [J/m] takes the kinetic energy
     that the PIC share removes from it, ½ m (|v_FLIP|² − |v_p|²) with v_FLIP = v_p + sum N dv_I: the blend then
@@ -59,7 +81,13 @@ def g2p_velocity(
             vp += N * g_vel[n]
             dv += N * g_dvel[n]
     v_flip = v[p] + dv
-    v_new = flip * v_flip + (F64(1.0) - flip) * vp
+    f = flip_bodies
+    target = vp
+    if mat_kind[p] == MAT_GAS:
+        f = flip
+        if own != 0 and f < F64(1.0):
+            target = gas_velocity(bx, by, wx, wy, geo, g_vel_gas, g_dvel)
+    v_new = f * v_flip + (F64(1.0) - f) * target
     if heating != 0 and mat_kind[p] == MAT_GAS:      # an elastic body's energy is not heat: not booked
         ie[p] = ie[p] + blend_heat(mass[p], v_flip, v_new)
     v[p] = v_new

@@ -64,13 +64,21 @@ def update_grid_momentum(
     g_vel: wp.array(dtype=wp.vec2d),
     g_dvel: wp.array(dtype=wp.vec2d),
 ):
-    """p_I += dt f_I on nodes above the mass cut-off m_cut [kg/m]; writes v_I and the increment dv_I."""
+    """p_I += dt f_I on nodes above the mass cut-off m_cut [kg/m]; writes v_I and the increment dv_I.
+
+    A node at or below the cut-off takes no force (dv_I = 0: its tiny mass would turn a force into a huge
+    acceleration) but keeps its velocity p_I/m_I, a weighted mean of its points' velocities, so that the PIC share
+    of the blend and the points' motion see the gas's own velocity there, not a node at rest (which lost momentum
+    at the fringe of expanding gas)."""
     n = box_node(wp.tid(), i0, j0, bw, nx)
     m = g_mass[n]
     if m <= m_cut:
-        g_mom[n] = wp.vec2d()
-        g_vel[n] = wp.vec2d()
+        v_keep = wp.vec2d()
+        if m > wp.float64(0.0):
+            v_keep = apply_bc(g_mom[n] / m, bc_mask[n], bc_vel[n])
+        g_vel[n] = v_keep
         g_dvel[n] = wp.vec2d()
+        g_mom[n] = m * v_keep
         return
     v_old = g_mom[n] / m
     v_new = apply_bc((g_mom[n] + dt * g_force[n]) / m, bc_mask[n], bc_vel[n])
@@ -89,13 +97,12 @@ def velocity_from_momentum(
     bc_mask: wp.array(dtype=wp.int32),
     bc_vel: wp.array(dtype=wp.vec2d),
     g_mom: wp.array(dtype=wp.vec2d),
-    m_cut: wp.float64,
     g_vel: wp.array(dtype=wp.vec2d),
 ):
-    """v_I = p_I / m_I after the MUSL remap (0 below the cut-off), boundary conditions applied."""
+    """v_I = p_I / m_I after the MUSL remap (0 on empty nodes), boundary conditions applied."""
     n = box_node(wp.tid(), i0, j0, bw, nx)
     m = g_mass[n]
-    if m <= m_cut:
+    if m <= wp.float64(0.0):
         g_vel[n] = wp.vec2d()
         return
     g_vel[n] = apply_bc(g_mom[n] / m, bc_mask[n], bc_vel[n])

@@ -11,6 +11,7 @@ from __future__ import annotations
 import warp as wp
 
 from blastfrac.mpm.apic import affine_from_moments, affine_inertia
+from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.shape import GridGeometry, stencil_1d, wrap_index
 
 F64 = wp.float64
@@ -116,3 +117,32 @@ def p2g_momentum(
                 wp.atomic_add(g_mom, n, N * mv + (N * m) * (Cp * dx))
             else:
                 wp.atomic_add(g_mom, n, N * mv)
+
+
+@wp.kernel
+def p2g_gas(
+    x: wp.array(dtype=wp.vec2d),
+    v: wp.array(dtype=wp.vec2d),
+    mass: wp.array(dtype=wp.float64),
+    active: wp.array(dtype=wp.int32),
+    mat_kind: wp.array(dtype=wp.int32),
+    geo: GridGeometry,
+    g_mass: wp.array(dtype=wp.float64),
+    g_mom: wp.array(dtype=wp.vec2d),
+):
+    """The gas's own nodal mass and momentum, m_I = sum N m_p and p_I = sum N m_p v_p over the gas points alone
+    [kg/m, N s/m]: the PIC share of the gas's blend aims at this velocity where elastic bodies share its nodes,
+    so that the blend exchanges no momentum between gas and bodies (:func:`~blastfrac.mpm.kernels_g2p.g2p_velocity`)."""
+    p = wp.tid()
+    if active[p] == 0 or mat_kind[p] != MAT_GAS:
+        return
+    bx, by, wx, dwx, wy, dwy = particle_stencil(x[p], geo.x0, geo.y0, geo.inv_h, geo.kind, geo.l)
+    m = mass[p]
+    mv = m * v[p]
+    for i in range(3):
+        ii = wrap_index(bx + i, geo.nx, geo.px)
+        for j in range(3):
+            n = wrap_index(by + j, geo.ny, geo.py) * geo.nx + ii
+            N = wx[i] * wy[j]
+            wp.atomic_add(g_mass, n, N * m)
+            wp.atomic_add(g_mom, n, N * mv)

@@ -51,7 +51,7 @@ from blastfrac.mpm.kernels_grid import (
     velocity_from_momentum,
 )
 from blastfrac.mpm.kernels_misc import max_signal_speed
-from blastfrac.mpm.kernels_p2g import p2g, p2g_momentum
+from blastfrac.mpm.kernels_p2g import p2g, p2g_gas, p2g_momentum
 from blastfrac.mpm.kernels_solid import update_elastic_state
 from blastfrac.mpm.seeding import charge_area_centroid, charge_bbox, seed_charges
 from blastfrac.mpm.shape import SHAPE_IDS, grid_geometry, shape_1d_np
@@ -61,16 +61,17 @@ F64 = np.float64
 
 @dataclass(frozen=True)
 class MPMOptions:
-    """Numerical options (see ExplosiveConfig for meanings and units)."""
+    """Numerical options (see ExplosiveConfig for meanings and units; the defaults are the scenario's)."""
 
     shape: str = "bspline2"
     ppc: int = 2
     transfer: str = "flip"
-    flip: float = 1.0
-    blend_heating: bool = False
+    flip: float = 0.99
+    flip_bodies: float = 1.0
+    blend_heating: bool = True
     cfl: float = 0.2
     q1: float = 1.5
-    q2: float = 0.06
+    q2: float = 2.0
     mass_cutoff: float = 1e-5
     v_max: float = 100.0
     burn_mode: str = "combined"
@@ -179,6 +180,7 @@ class MPMSolver:
             ppc=config.grid.points_per_cell,
             transfer=config.transfer,
             flip=config.flip,
+            flip_bodies=config.flip_bodies,
             blend_heating=config.blend_heating,
             cfl=config.cfl,
             q1=config.q1,
@@ -294,6 +296,13 @@ class MPMSolver:
         self.shape_l = 0.5 / opts.ppc  # uGIMP l_p / h
         self.m_cut = opts.mass_cutoff * rho0 * spec.h**2
         d = self.device
+        # gas and elastic bodies on one grid with a FLIP/PIC blend: the gas's PIC share aims at the gas's own nodal
+        # velocity (kernels_p2g.p2g_gas), kept in arrays of its own
+        self.own_gas_velocity = bool(self.n_solid and gas.any() and not self.apic and opts.flip < 1.0)
+        nn = spec.node_count if self.own_gas_velocity else 1
+        self.gas_mass, self.gas_mom, self.gas_vel, self.gas_scratch = (
+            wp.zeros(nn, dtype=t, device=d) for t in (wp.float64, wp.vec2d, wp.vec2d, wp.vec2d))
+        self.gas_no_bc = wp.zeros(nn, dtype=wp.int32, device=d)
 
         def z(dtype):
             return wp.zeros(n, dtype=dtype, device=d)
@@ -463,6 +472,13 @@ class MPMSolver:
             device=self.device,
         )
         self._fold_walls(1)
+        if self.own_gas_velocity:
+            gas = (self.gas_mass, self.gas_mom, self.gas_scratch)
+            self._launch(clear_grid_box, dim=g.box_node_count, inputs=[*g.box_args(), 1], outputs=list(gas),
+                         device=self.device, key="p2g_gas")
+            self._launch(p2g_gas, dim=self.n, inputs=[self.x, self.v, self.mass, self.active, self.mat_kind, self.geo],
+                         outputs=[self.gas_mass, self.gas_mom], device=self.device)
+            self._fold_walls(1, gas)
 
     def update_grid(self, dt: float) -> None:
         """Integrate node momenta over dt [s] with the mass cut-off and boundary conditions."""
@@ -475,22 +491,29 @@ class MPMSolver:
             device=self.device,
         )
         self._wall_ghosts(1)
+        if self.own_gas_velocity:                # the gas's own velocity before the update: p^gas / m^gas, no BC
+            self._launch(velocity_from_momentum, dim=g.box_node_count,
+                         inputs=[*g.box_args(), self.gas_mass, self.gas_no_bc, g.bc_vel, self.gas_mom],
+                         outputs=[self.gas_vel], device=self.device, key="gas")
+            self._wall_ghosts(0, (self.gas_mass, self.gas_vel, self.gas_scratch, self.gas_mom))
 
-    def _fold_walls(self, with_mass_force: int) -> None:
-        """Image walls: fold the ghosts' P2G sums onto their images, x walls then y walls."""
+    def _fold_walls(self, with_mass_force: int, arrays=None) -> None:
+        """Image walls: fold the ghosts' P2G sums (mass, momentum, force) onto their images, x walls then y."""
         g = self.grid
+        out = list(arrays or (g.mass, g.mom, g.force))
         for a in g.mirror_axes:
             self._launch(fold_wall_images, dim=g.box_node_count,
                          inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], with_mass_force],
-                         outputs=[g.mass, g.mom, g.force], device=self.device, key=a)
+                         outputs=out, device=self.device, key=(a, arrays is None))
 
-    def _wall_ghosts(self, with_dvel: int) -> None:
-        """Image walls: ghosts take their images' velocities, x walls then y walls."""
+    def _wall_ghosts(self, with_dvel: int, arrays=None) -> None:
+        """Image walls: ghosts take their images' velocities (mass, velocity, increment, momentum), x walls then y."""
         g = self.grid
+        m, *out = arrays or (g.mass, g.vel, g.dvel, g.mom)
         for a in g.mirror_axes:
             self._launch(set_wall_ghosts, dim=g.box_node_count,
-                         inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], g.mass, with_dvel],
-                         outputs=[g.vel, g.dvel, g.mom], device=self.device, key=a)
+                         inputs=[*g.box_args(), g.mirror[a], g.mirror_sign[a], m, with_dvel],
+                         outputs=out, device=self.device, key=(a, arrays is None))
 
     def to_particles(self, dt: float) -> None:
         """G2P (FLIP/PIC or APIC), MUSL remap (with the affine term), velocity gradient, volume and position update."""
@@ -504,8 +527,9 @@ class MPMSolver:
             self._launch(
                 g2p_velocity,
                 dim=self.n,
-                inputs=[self.x, self.active, g.vel, g.dvel, geo, F64(self.opts.flip),
-                        int(bool(self.opts.blend_heating) and self.opts.flip < 1.0), self.mass, self.mat_kind],
+                inputs=[self.x, self.active, g.vel, g.dvel, geo, F64(self.opts.flip), F64(self.opts.flip_bodies),
+                        int(bool(self.opts.blend_heating) and self.opts.flip < 1.0), self.mass, self.mat_kind,
+                        int(self.own_gas_velocity), self.gas_vel],
                 outputs=[self.v, self.v_pic, self.ie],
                 device=d,
             )
@@ -517,7 +541,7 @@ class MPMSolver:
         self._launch(
             velocity_from_momentum,
             dim=g.box_node_count,
-            inputs=[*g.box_args(), g.mass, g.bc_mask, g.bc_vel, g.mom, F64(self.m_cut)],
+            inputs=[*g.box_args(), g.mass, g.bc_mask, g.bc_vel, g.mom],
             outputs=[g.vel],
             device=d,
         )

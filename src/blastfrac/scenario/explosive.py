@@ -315,16 +315,21 @@ class ExplosiveConfig(_Model):
         default="flip", description="grid-to-particle velocity transfer: 'flip' (the FLIP/PIC blend set by `flip`) or "
         "'apic' (affine particle-in-cell, Jiang et al. 2015: each point also carries the affine moment B_p [m^2/s] of "
         "its velocity field, C_p = B_p D_p^-1 [1/s]; conserves linear and angular momentum; `flip` is then unused). "
-        "Measured (docs/explosive.md): in Sod's tube at 400 cells APIC's velocity scatters 1.4 % behind the shock "
-        "(FLIP 14 %) and overshoots by 12 % (FLIP 46 %), but its transfers lose 12 % of the kinetic energy (FLIP 0.5 %), "
-        "its shock lags 2.5 cells, and a wall-initiated slab delivers 2.4 % less impulse than exact (FLIP within 0.7 %), "
-        "hence the FLIP blend stays the default"
+        "Measured (docs/explosive.md): APIC quiets Sod's tube but its transfers lose 12 % of the kinetic energy, its "
+        "shock lags 2.5 cells and a wall-initiated slab delivers 2.4 % less impulse than exact, hence the FLIP blend "
+        "is the default"
     )
     flip: float = Field(
-        default=1.0, ge=0, le=1, description="FLIP fraction of the FLIP/PIC velocity blend (1 = pure FLIP, as MPM3D; "
-        "0 = PIC), used when transfer = 'flip' [-]. "
-        "0.99 with blend_heating removes pure FLIP's long-run noise in a sealed hole but changes the near-wall "
-        "damage (docs/explosive.md 'Velocity transfer'), so 1.0 stays the default"
+        default=0.99, ge=0, le=1, description="FLIP fraction of the FLIP/PIC velocity blend of the detonation products "
+        "(1 = pure FLIP, as MPM3D; 0 = PIC), used when transfer = 'flip' [-]; elastic bodies use `flip_bodies`. Default 0.99 (since 0.2; was 1.0) with blend_heating and q2 = 2: "
+        "chosen on Sod's tube (overshoot 46 % -> 4.3 %, plateaus within 1 %) and the wall impulse of a detonating slab "
+        "(within 1.8 %), and it removes pure FLIP's long-run velocity noise in a sealed hole (docs/explosive.md, "
+        "'Velocity transfer')"
+    )
+    flip_bodies: float = Field(
+        default=1.0, ge=0, le=1, description="FLIP fraction of the elastic bodies' points (`bodies`), used when "
+        "transfer = 'flip' [-]; `flip` is the gas's. Default 1 (pure FLIP): a body's kinetic energy is not heat, so a "
+        "PIC share would dissipate it unbooked (a vibrating bar loses its energy)"
     )
     blend_heating: bool = Field(
         default=True, description="with transfer = 'flip' and flip < 1: the kinetic energy the PIC share removes "
@@ -332,8 +337,12 @@ class ExplosiveConfig(_Model):
         "particles' velocity noise without losing energy (docs/explosive.md, 'Velocity transfer')"
     )
     cfl: float = Field(default=0.2, gt=0, le=0.5, description="CFL factor alpha in dt = alpha h / max(c + |v|) [-]")
-    q1: float = Field(default=1.5, ge=0, le=10, description="quadratic artificial-viscosity coefficient Q1 [-]")
-    q2: float = Field(default=0.06, ge=0, le=2, description="linear artificial-viscosity coefficient Q2 [-]")
+    q1: float = Field(default=1.5, ge=0, le=10, description="quadratic artificial-viscosity coefficient Q1 [-] "
+                      "of q = ρl(Q1·l·(tr D)² − Q2·c·tr D), l = √V_p the point spacing")
+    q2: float = Field(default=2.0, ge=0, le=5, description="linear artificial-viscosity coefficient Q2 [-]; c is the "
+                      "products' own sound speed (of the burnt share). Default 2 (since 0.2; was 0.06, applied to the "
+                      "time step's signal speed): about 1 on the cell width at 2 points per cell, measured on Sod's "
+                      "tube and the slab's wall impulse (docs/explosive.md, 'Artificial viscosity')")
     mass_cutoff: float = Field(
         default=1e-5, ge=0, lt=1, description="node mass cut-off as a fraction of rho0 h^2 (per unit thickness) [-]"
     )
