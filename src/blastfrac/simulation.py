@@ -147,7 +147,7 @@ class Simulation:
             kc = body_contact_stiffness(self.gas.bodies, cp.stiffness_factor)
         self.coupler = GasRockCoupler(self.model, self.gas, kc, cp.damping_ratio, cp.friction, cp.rebuild_interval,
                                       force_cap=cp.force_cap, surface_forces=cp.surface_forces,
-                                      pressure_preload=cp.pressure_preload)
+                                      pressure_preload=cp.pressure_preload, contact_heating=cp.contact_heating)
         if sc.geometry.boreholes:
             from .analysis.wall_load import WallLoad
 
@@ -523,6 +523,8 @@ class Simulation:
             e.update(gas_energies(self.gas))
             c = self.coupler.energies()
             e["contact_energy"] = c["contact_energy"]
+            if self.coupler.contact_heating:
+                e["contact_heat"] = c["contact_heat"]          # already in gas_internal: not a budget term
             if self.crack_gas is not None:
                 e["crack_gas"] = self.crack_gas.energies()["crack_gas"]
         return e

@@ -18,9 +18,10 @@ import warp as wp
 from .._warp import Launcher
 from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
-from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_STORED, account_rock_work_and_clear,
-                              accumulate_gas_contact_work, add_reactions_with_work, collect_exposed_elements,
-                              eval_particle_edge_contact)
+from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEATED, ACC_SIZE, ACC_STORED,
+                              account_rock_work_and_clear, accumulate_gas_contact_work, add_reactions_with_work,
+                              book_contact_heat, collect_exposed_elements, eval_particle_edge_contact,
+                              heat_gas_from_contacts)
 
 
 def default_contact_stiffness(p_cj: float, factor: float = 20.0) -> float:
@@ -42,8 +43,10 @@ class GasRockCoupler:
 
     def __init__(self, model, mpm, kc: float, zeta: float = 0.0, mu: float = 0.0, rebuild_interval: int = 5,
                  r_max: float | None = None, force_cap: float = 0.0, surface_forces: bool = True,
-                 pressure_preload: bool = True):
+                 pressure_preload: bool = True, contact_heating: bool = False):
         self.model, self.mpm = model, mpm
+        # the contacts' dissipation heats the gas (not with elastic bodies, whose contacts share the book)
+        self.contact_heating = bool(contact_heating) and mpm.n_solid == 0
         self.surface_forces, self.pressure_preload = bool(surface_forces), bool(pressure_preload)
         self.force_cap = float(force_cap)
         self.kc, self.zeta, self.mu = float(kc), float(zeta), float(mu)
@@ -63,7 +66,8 @@ class GasRockCoupler:
         self.reach_max = wp.zeros(1, dtype=wp.float64, device=d)
         self.elems = wp.zeros(E, dtype=wp.int32, device=d)
         self.points = wp.zeros(E, dtype=wp.vec3d, device=d)
-        self.acc = wp.zeros(3, dtype=wp.float64, device=d)
+        self.acc = wp.zeros(ACC_SIZE, dtype=wp.float64, device=d)
+        self.diss_p = wp.zeros(max(1, mpm.n), dtype=wp.float64, device=d)   # contacts' dissipation rate per point [W/m]
         self._launch = Launcher()                 # recorded launches of the per-step kernels (_warp.Launcher)
         self.f_react = wp.zeros(model.node_count, dtype=wp.vec2d, device=d)   # this step's reactions [N/m]
         self._dt_work = 0.0                     # step length of the forces whose second half of work is pending [s]
@@ -174,8 +178,8 @@ class GasRockCoupler:
                              wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
                              wp.float64(self.query_radius), wp.float64(dt), wp.float64(float(self.surface_forces)),
                              wp.float64(float(self.pressure_preload)), wp.float64(w_old), wp.float64(0.5 * dt),
-                             *self._hist[0]],
-                     outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1]],
+                             wp.float64(float(self.contact_heating)), mpm.mat_kind, *self._hist[0]],
+                     outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1], self.diss_p],
                      device=m.device, key=id(self._hist[0][0]))          # one record per history buffer
         self._hist.reverse()
 
@@ -184,6 +188,10 @@ class GasRockCoupler:
         velocities before the step."""
         self._launch(add_reactions_with_work, dim=self.model.node_count,
                      inputs=[state.f, self.f_react, state.v, self._w_react, self.acc], device=self.model.device)
+        if self.contact_heating:                          # the contacts' dissipation so far heats the gas in contact
+            self._launch(heat_gas_from_contacts, dim=self.mpm.n, inputs=[self.acc, self.diss_p],
+                         outputs=[self.mpm.ie], device=self.model.device)
+            self._launch(book_contact_heat, dim=1, inputs=[], outputs=[self.acc], device=self.model.device)
 
     def energies(self) -> dict[str, float]:
         """contact_energy: work absorbed by the contacts so far, −∫(P_gas + P_rock) dt [J/m] with the power put into
@@ -194,4 +202,4 @@ class GasRockCoupler:
         next step's forces)."""
         a = self.acc.numpy()
         return {"contact_energy": float(a[ACC_ABSORBED]), "contact_penalty": float(a[ACC_STORED]),
-                "contacts": int(a[ACC_CONTACTS])}
+                "contacts": int(a[ACC_CONTACTS]), "contact_heat": float(a[ACC_HEATED])}

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import warp as wp
 
+from blastfrac.mpm.bodies import MAT_GAS
+
 from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap,
                             pressure_offset, vertex_overlap)
 
@@ -11,6 +13,9 @@ from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initia
 ACC_ABSORBED = wp.constant(0)   # work absorbed by the contacts since the start, −∫(P_gas + P_rock) dt [J/m]
 ACC_STORED = wp.constant(1)     # penalty energy ½k_c·δ² stored in the contacts at this step [J/m]
 ACC_CONTACTS = wp.constant(2)   # number of particle–element contacts at this step [-]
+ACC_DISS = wp.constant(3)       # Σ over gas points of the contacts' dissipation rate at this step [W/m]
+ACC_HEATED = wp.constant(4)     # contact dissipation handed to the gas as heat since the start [J/m]
+ACC_SIZE = 5
 
 
 @wp.func
@@ -94,6 +99,8 @@ def eval_particle_edge_contact(
     preload: wp.float64,
     w_old: wp.float64,
     w_new: wp.float64,
+    heat: wp.float64,
+    mat_kind: wp.array(dtype=wp.int32),
     hist_e_in: wp.array(dtype=wp.int32),
     hist_d_in: wp.array(dtype=wp.float64),
     hist_x_in: wp.array(dtype=wp.float64),
@@ -104,6 +111,7 @@ def eval_particle_edge_contact(
     hist_e_out: wp.array(dtype=wp.int32),
     hist_d_out: wp.array(dtype=wp.float64),
     hist_x_out: wp.array(dtype=wp.float64),
+    diss_p: wp.array(dtype=wp.float64),
 ):
     """Contact force on each particle (assigned to f_p) and its reactions on the rock nodes (added to f_react,
     which the step adds to the rock's forces: coupler.add_reactions), METHOD §3.
@@ -137,6 +145,7 @@ def eval_particle_edge_contact(
     rp = wp.min(wp.float64(0.5) * wp.sqrt(vol_p[p]), r_max)
     rc = rp + preload * pressure_offset(p_p[p], rp, kc)
     stored = wp.float64(0.0)
+    qsum = wp.float64(0.0)
     ncon = int(0)
     query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius)
     idx = int(0)
@@ -211,6 +220,7 @@ def eval_particle_edge_contact(
             if kappa > zero:
                 fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
             f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
+            qsum = qsum + pw
             fsum = fsum + f
             msum = msum + wp.outer(f, arm)
             wp.atomic_add(f_react, ia, -wa * f)
@@ -220,6 +230,13 @@ def eval_particle_edge_contact(
     f_p[p] = fsum
     fm_p[p] = msum
     work = work + w_new * contact_power(fsum, msum, vp, Lp)         # this step's forces, their first half
+    if heat > zero:                                   # this step's dissipation rate, the weight of the gas's heat
+        q = zero
+        if mat_kind[p] == MAT_GAS:
+            q = qsum
+        diss_p[p] = q
+        if q > zero:
+            wp.atomic_add(acc, ACC_DISS, q)
     if work != zero:
         wp.atomic_add(acc, ACC_ABSORBED, -work)
     if ncon > 0:
@@ -261,6 +278,7 @@ def account_rock_work_and_clear(
     if i == 0:
         acc[ACC_STORED] = wp.float64(0.0)
         acc[ACC_CONTACTS] = wp.float64(0.0)
+        acc[ACC_DISS] = wp.float64(0.0)
     f = f_react[i]
     if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
         if w != wp.float64(0.0):
@@ -291,3 +309,37 @@ def add_node_loads(f: wp.array(dtype=wp.vec2d), a: wp.array(dtype=wp.vec2d)):
     """f += a [N/m] (the gas loads on the rock nodes, added after the rock's own forces in a fixed order)."""
     i = wp.tid()
     f[i] = f[i] + a[i]
+
+
+@wp.func
+def contact_heat(acc: wp.array(dtype=wp.float64)):
+    """Q [J/m]: what the contacts have dissipated and not yet handed on, max(absorbed − stored, 0), when some gas
+    point's contacts dissipate this step (else 0: it waits)."""
+    q = acc[ACC_ABSORBED] - acc[ACC_STORED]
+    if q <= wp.float64(0.0) or acc[ACC_DISS] <= wp.float64(0.0):
+        return wp.float64(0.0)
+    return q
+
+
+@wp.kernel
+def heat_gas_from_contacts(acc: wp.array(dtype=wp.float64), diss_p: wp.array(dtype=wp.float64),
+                           ie: wp.array(dtype=wp.float64)):
+    """ie_p += Q·q_p / Σq [J/m]: the contacts' dissipation Q (:func:`contact_heat`) heats the gas points in contact,
+    in proportion to their contacts' dissipation rates q_p [W/m] this step (coupling.contact_heating)."""
+    p = wp.tid()
+    q = diss_p[p]
+    if q <= wp.float64(0.0):
+        return
+    Q = contact_heat(acc)
+    if Q > wp.float64(0.0):
+        ie[p] = ie[p] + Q * (q / acc[ACC_DISS])
+
+
+@wp.kernel
+def book_contact_heat(acc: wp.array(dtype=wp.float64)):
+    """One thread, after :func:`heat_gas_from_contacts`: the heat leaves the contacts' book (absorbed −= Q) and is
+    counted in acc[HEATED], so the energy budget is unchanged."""
+    Q = contact_heat(acc)
+    if Q > wp.float64(0.0):
+        acc[ACC_ABSORBED] = acc[ACC_ABSORBED] - Q
+        acc[ACC_HEATED] = acc[ACC_HEATED] + Q

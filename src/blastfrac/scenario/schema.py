@@ -406,6 +406,13 @@ class CouplingConfig(_Strict):
         "(capped at r_p/4), so that a particle touching a wall pushes with its own pressure at once instead of first "
         "accelerating into it [-]. Off, a suddenly loaded wall sees about 1.2–1.4 p at ignition.",
     )
+    contact_heating: bool = Field(
+        True, description="Hand what the gas–rock contacts dissipate (dashpot, friction and force-cap losses: the "
+        "work they absorbed less the penalty energy they hold) to the gas points in contact as internal energy, in "
+        "proportion to their contacts' dissipation this step: the contact stands for an unresolved stagnation shock, "
+        "whose heat stays in the gas [-]. The energy budget is unchanged (the heat leaves the contact book); "
+        "summary.json energy → contact_heat. Not with elastic MPM bodies (their contacts share the book).",
+    )
     rebuild_interval: int = Field(
         5, ge=1, le=100, description="Steps between rebuilds of the exposed-edge search structure [-]."
     )
