@@ -15,7 +15,7 @@ def _scenario(threads: int) -> dict:
         "output": {"paraview": False, "figures": False},
         "rock": {"density": 2600.0, "youngs_modulus": 50e9, "poisson_ratio": 0.2, "tensile_strength": 10e6,
                  "cohesion": 40e6, "friction_angle": 40.0, "residual_friction_angle": 30.0,
-                 "bulk_viscosity_linear": 0.03, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.1},
+                 "bulk_viscosity_linear": 0.02, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.15},
         "geometry": {"domain": {"type": "rectangle", "width": 0.04, "height": 0.04}, "mesh_size": 5 * h,
                      "mesh_size_near": h, "refinement_distance": 0.012,
                      "boreholes": [{"center": [0.0, 0.0], "radius": r_b}]},

@@ -30,7 +30,7 @@ def blast(tmp_path_factory):
         "title": "small coupled blast",
         "simulation": {"end_time": 20e-6, "progress": False},
         "output": {"paraview": True, "figures": True, "interval": 5e-6},
-        "rock": {**ROCK, "bulk_viscosity_linear": 0.03, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.1,
+        "rock": {**ROCK, "bulk_viscosity_linear": 0.02, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.15,
                  "tensile_fracture_energy": 50.0, "shear_fracture_energy": 500.0},
         "geometry": {"domain": {"type": "rectangle", "width": 0.12, "height": 0.12}, "mesh_size": 8 * h,
                      "mesh_size_near": h, "refinement_distance": 0.036,

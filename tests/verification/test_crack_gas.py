@@ -178,7 +178,7 @@ def blast_with_crack_gas(tmp_path_factory):
         "title": "small coupled blast with crack gas",
         "simulation": {"end_time": 12e-6, "progress": False},
         "output": {"paraview": False, "figures": False},
-        "rock": {**BLAST_ROCK, "bulk_viscosity_linear": 0.03, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.1,
+        "rock": {**BLAST_ROCK, "bulk_viscosity_linear": 0.02, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.15,
                  "tensile_fracture_energy": 50.0, "shear_fracture_energy": 500.0},
         "geometry": {"domain": {"type": "rectangle", "width": 0.06, "height": 0.06}, "mesh_size": 6 * h,
                      "mesh_size_near": h, "refinement_distance": 0.02,

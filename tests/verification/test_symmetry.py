@@ -41,7 +41,7 @@ T_END = 10e-6
 WINDOW = 1e-6
 ROCK_BREAKABLE = {"density": 2600.0, "youngs_modulus": 50e9, "poisson_ratio": 0.2, "tensile_strength": 10e6,
                   "cohesion": 40e6, "friction_angle": 40.0, "residual_friction_angle": 30.0,
-                  "bulk_viscosity_linear": 0.03, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.1,
+                  "bulk_viscosity_linear": 0.02, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.15,
                   "tensile_fracture_energy": 50.0, "shear_fracture_energy": 500.0}
 MODELS = {"full": [], "half_left": ["left"], "half_bottom": ["bottom"], "quarter": ["left", "bottom"]}
 
