@@ -108,8 +108,8 @@ def test_small_coupled_blast(blast):
 
 
 @pytest.mark.xfail(strict=True, reason="known gap (issue 11): the crushed zone is below the empirical bracket. With "
-                   "the 0.2 gas defaults r_c = 1.24 r_b here; with the rock mesh and the MPM cell halved 1.12 r_b with "
-                   "the blend and with pure FLIP alike, so pure FLIP's 2.43 r_b at this resolution was not converged "
+                   "the 0.2 defaults r_c = 1.24 r_b here; with the rock mesh and the MPM cell halved 1.12 r_b with them "
+                   "and with pure FLIP alike, so pure FLIP's 2.43 r_b at this resolution was not converged "
                    "(docs/explosive.md, 'Velocity transfer')")
 def test_crushed_zone_in_the_empirical_bracket(blast):
     _, s, _ = blast
