@@ -301,6 +301,7 @@ class Simulation:
         self.insitu_report = {
             "method": ins.method, "steps": steps, "pseudo_time": t_relax, "converged": bool(converged),
             "kinetic_to_strain_ratio": ratio, "broken_tensile": counts["tensile"], "broken_shear": counts["shear"],
+            "broken_crushed": counts["crushed"],
             "softening": int(softening.sum()), "failures_allowed": ins.allow_failure, "wall_check": self._kirsch_check(),
         }
         self.time, self.steps = 0.0, 0
@@ -601,8 +602,8 @@ class Simulation:
             "simulated_time": self.time,
             "wall_time_s": wall,
             "element_steps_per_s": m.element_count * self.steps / wall if wall > 0 else None,
-            "broken_springs": {"tensile": counts["tensile"], "shear": counts["shear"],
-                               "total": counts["tensile"] + counts["shear"]},
+            "broken_springs": {"tensile": counts["tensile"], "shear": counts["shear"], "crushed": counts["crushed"],
+                               "total": counts["tensile"] + counts["shear"] + counts["crushed"]},
             "fracture_degree": self.fracture.sample(mode),
             "energy": {**e, "initial_stored": self.initial_stored, "initial_dissipated": self.initial_dissipated,
                        "budget_error": err, "budget_error_relative": rel},

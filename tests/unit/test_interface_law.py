@@ -13,7 +13,8 @@ from blastfrac.materials import interface as law
 def _run_intact(inp: wp.array2d(dtype=wp.float64), flag: wp.array(dtype=wp.int32), out: wp.array2d(dtype=wp.float64)):
     i = wp.tid()
     r = law.spring_update_intact(inp[i, 0], inp[i, 1], inp[i, 2], inp[i, 3], inp[i, 4], inp[i, 5], inp[i, 6],
-                                 inp[i, 7], inp[i, 8], inp[i, 9], inp[i, 10], inp[i, 11], inp[i, 12], flag[i])
+                                 inp[i, 7], inp[i, 8], inp[i, 9], inp[i, 10], inp[i, 11], inp[i, 12], flag[i],
+                                 inp[i, 13])
     for k in range(5):
         out[i, k] = r[k]
 
@@ -41,7 +42,9 @@ def _random_intact_cases(n, rng):
     tanr = np.tan(np.radians(rng.uniform(5, 40, n)))
     slope_t = np.where(rng.random(n) < 0.5, 0.0, t0**2 / (2 * rng.uniform(10, 200, n)))
     slope_c = np.where(rng.random(n) < 0.5, 0.0, c0**2 / (2 * rng.uniform(50, 2000, n)))
-    return np.stack([fn, fs, t0, c0, dn, ds, kn, ks, ac, tanp, tanr, slope_t, slope_c], 1)
+    # crushing strength: none for half the cases, else within the compressive range of fn
+    crush = np.where(rng.random(n) < 0.5, 0.0, rng.uniform(1.0, 4.0, n) * t0)
+    return np.stack([fn, fs, t0, c0, dn, ds, kn, ks, ac, tanp, tanr, slope_t, slope_c, crush], 1)
 
 
 def test_intact_law_matches_numpy_twin():
@@ -53,10 +56,11 @@ def test_intact_law_matches_numpy_twin():
     wp.launch(_run_intact, dim=len(inp), inputs=[wp.array(inp, dtype=wp.float64, device="cpu"),
                                                  wp.array(flag, dtype=wp.int32, device="cpu")], outputs=[out], device="cpu")
     got = out.numpy()
-    want = np.array([law.np_spring_update_intact(*row, breakable=f) for row, f in zip(inp, flag)], dtype=float)
+    want = np.array([law.np_spring_update_intact(*row[:13], breakable=f, crush=row[13]) for row, f in zip(inp, flag)],
+                    dtype=float)
     np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-300)
     modes = set(want[:, 4].astype(int))
-    assert modes == {law.INTACT, law.TENSILE, law.SHEAR}, "the random cases must exercise every branch"
+    assert modes == {law.INTACT, law.TENSILE, law.SHEAR, law.CRUSHED}, "the random cases must exercise every branch"
 
 
 def test_broken_law_matches_numpy_twin():
@@ -96,6 +100,25 @@ def test_mohr_coulomb_threshold_eq20():
     assert broke[4] == law.SHEAR
     # after a shear break the residual friction carries the load: |Fs| = Fn tan φ_r
     assert math.isclose(abs(broke[1]), sn * ac * math.tan(math.radians(50)), rel_tol=1e-12)
+
+
+def test_crushing_cap_threshold_keeps_the_normal_force():
+    """Fn/Ac reaching σ_cr crushes the spring; the normal force is kept, the shear capped at Fn·tanφ_r, and a cap
+    of 0 (the paper's law) never crushes, however far the spring is compressed."""
+    crush, ac, k = 150e6, 1e-3, 1e15
+    tan_r = math.tan(math.radians(30))
+    args = dict(t_str=10e6, c_str=40e6, ds=0.0, kn=k * ac, ks=k * ac, ac=ac, tan_phi=math.tan(math.radians(40)),
+                tan_phi_r=tan_r, slope_t=0.0, slope_c=0.0)
+    dn = -crush / k                               # closing that brings σ_n to σ_cr
+    fs0 = 0.9 * crush * ac                        # shear below Mohr-Coulomb at σ_cr, above residual friction
+    below = law.np_spring_update_intact(0.0, fs0, dn=0.999 * dn, crush=crush, **args)
+    above = law.np_spring_update_intact(0.0, fs0, dn=1.001 * dn, crush=crush, **args)
+    paper = law.np_spring_update_intact(0.0, 0.0, dn=100 * dn, crush=0.0, **args)
+    assert below[4] == law.INTACT and above[4] == law.CRUSHED
+    assert math.isclose(above[0], 1.001 * crush * ac, rel_tol=1e-12)
+    assert math.isclose(above[1], above[0] * tan_r, rel_tol=1e-12)
+    assert paper[4] == law.INTACT
+    assert law.crushing_failure(above[0], crush, ac) and not law.crushing_failure(below[0], crush, ac)
 
 
 @pytest.mark.parametrize("gf", [20.0, 100.0])

@@ -1,4 +1,4 @@
-"""Fracture degree: broken springs over all springs, split tensile/shear, globally and per zone.
+"""Fracture degree: broken springs over all springs, split tensile/shear/crushed, globally and per zone.
 
 A *spring* is one node pair of an interface (its normal and tangential parts break together),
 so an interior edge holds two springs. Zone membership is decided by the spring's reference
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..materials.interface import SHEAR, TENSILE
+from ..materials.interface import CRUSHED, SHEAR, TENSILE
 from ..scenario.schema import AnnulusZone, RectangleZone, SectorZone
 
 
@@ -47,32 +47,36 @@ class FractureDegree:
         self.zone_totals = [int(m.sum()) for m in self.masks]
 
     def _modes(self, mode: np.ndarray):
-        tens = mode == TENSILE
-        shear = mode == SHEAR
+        tens, shear, crush = mode == TENSILE, mode == SHEAR, mode == CRUSHED
         if self.keep is not None:
-            tens, shear = tens & self.keep, shear & self.keep
-        return tens, shear
+            tens, shear, crush = tens & self.keep, shear & self.keep, crush & self.keep
+        return tens, shear, crush
 
     def sample(self, mode: np.ndarray) -> dict[str, float]:
-        """Fracture degrees from the spring mode array (0 intact, 1 tensile, 2 shear)."""
-        tens, shear = self._modes(mode)
+        """Fracture degrees from the spring mode array (0 intact, 1 tensile, 2 shear, 3 crushed: the compressive
+        cap rock.crushing_strength, always 0 without it)."""
+        tens, shear, crush = self._modes(mode)
         n = max(self.total, 1)
         row = {
-            "D": (tens.sum() + shear.sum()) / n,
+            "D": (tens.sum() + shear.sum() + crush.sum()) / n,
             "D_tensile": tens.sum() / n,
             "D_shear": shear.sum() / n,
+            "D_crushed": crush.sum() / n,
         }
         for z, m, nz in zip(self.zones, self.masks, self.zone_totals):
             den = max(nz, 1)
-            row[f"{z.name}:D"] = (tens[m].sum() + shear[m].sum()) / den
+            broken = tens[m].sum() + shear[m].sum() + crush[m].sum()
+            row[f"{z.name}:D"] = broken / den
             row[f"{z.name}:D_tensile"] = tens[m].sum() / den
             row[f"{z.name}:D_shear"] = shear[m].sum() / den
-            row[f"{z.name}:D_global"] = (tens[m].sum() + shear[m].sum()) / n
+            row[f"{z.name}:D_crushed"] = crush[m].sum() / den
+            row[f"{z.name}:D_global"] = broken / n
         return {k: float(v) for k, v in row.items()}
 
     def counts(self, mode: np.ndarray) -> dict[str, int]:
-        tens, shear = self._modes(mode)
-        return {"total": self.total, "tensile": int(tens.sum()), "shear": int(shear.sum())}
+        tens, shear, crush = self._modes(mode)
+        return {"total": self.total, "tensile": int(tens.sum()), "shear": int(shear.sum()),
+                "crushed": int(crush.sum())}
 
 
 def joint_spring_mask(model) -> np.ndarray | None:

@@ -154,7 +154,7 @@ def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
         lat = float(u[groups["right"], 0].mean() - u[groups["left"], 0].mean()) if len(groups["left"]) else 0.0
         hist.lateral_u.append(lat)
         hist.tensile.append(int(np.sum(mode == 1)))
-        hist.shear.append(int(np.sum(mode == 2)))
+        hist.shear.append(int(np.sum(mode >= 2)))          # shear, or crushed (rock.crushing_strength)
         if on_sample is not None:
             on_sample(min(1.0, step / max_steps), 0.5 * float(r[0] + r[1]) / spec.width)
         load = 0.5 * float(r[0] + r[1])

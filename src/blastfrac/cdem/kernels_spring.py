@@ -42,6 +42,7 @@ class SpringModel:
     slope_t: wp.float64
     slope_c: wp.float64
     zeta: wp.float64                            # spring dashpot damping ratio [-]
+    crush: wp.float64                           # compressive cap σ_cr [Pa], 0: none
     per_pair_law: wp.int32
     breakable: wp.int32
 
@@ -71,13 +72,14 @@ def spring_model(model, sm: SpringModel | None = None) -> SpringModel:
         sm.ac, sm.l0, sm.law, sm.node_mass = model.pair_ac, model.pair_l0, model.pair_law, model.node_mass
     sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c = model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c
     sm.zeta, sm.per_pair_law, sm.breakable = model.spring_damping, int(model.per_pair_law), int(model.breakable)
+    sm.crush = model.crush
     return sm
 
 
 def spring_scalars(model) -> tuple:
     """The model scalars a SpringModel holds (a change means spring_model must set them again)."""
     return (model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c, model.spring_damping,
-            int(model.per_pair_law), int(model.breakable))
+            int(model.per_pair_law), int(model.breakable), model.crush)
 
 
 def spring_state(state) -> SpringState:
@@ -150,7 +152,7 @@ def eval_spring_forces(
         if mode == 0:
             st = ss.strength[k]
             r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, sm.ac[k],
-                                     law[0], law[1], law[2], law[3], sm.breakable)
+                                     law[0], law[1], law[2], law[3], sm.breakable, sm.crush)
             fn = r[0]
             fs = r[1]
             ss.strength[k] = wp.vec2d(r[2], r[3])

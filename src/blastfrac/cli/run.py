@@ -73,6 +73,7 @@ def run(args) -> int:
                             "another --out") from None
     b = s["broken_springs"]
     print(f"{s['steps']} steps, t = {s['simulated_time'] * 1e6:.2f} µs, wall {s['wall_time_s']:.1f} s; "
-          f"broken springs {b['total']} (tensile {b['tensile']}, shear {b['shear']}) of {s['counts']['springs']}; "
+          f"broken springs {b['total']} (tensile {b['tensile']}, shear {b['shear']}"
+          f"{', crushed %d' % b['crushed'] if b.get('crushed') else ''}) of {s['counts']['springs']}; "
           f"results in {sim.out_dir}")
     return 0

@@ -8,6 +8,12 @@ together (the paper's "spring"). Forces are per unit thickness [N/m]; the normal
 Laws (METHOD.md §1.3, the paper's Eqs. 17–22):
 - elastic increments: Fn ← Fn − Kn·Δd_n (opening Δd_n > 0), Fs ← Fs − Ks·Δd_s;
 - tension (Y19): −Fn ≥ T·Ac; shear, Mohr–Coulomb (Y20): |Fs| ≥ Fn·tanφ + c·Ac;
+- crushing (optional, not in the paper): Fn ≥ σ_cr·Ac, a compression cap on the normal stress. A Mohr–Coulomb
+  spring with tension cut-off cannot fail in uniaxial strain at usual friction angles, so without it a blast's
+  crushed zone comes only from the hoop tension and the shear near the wall; lattice models of concrete and
+  rock close the envelope the same way (a compressive cap). A crushed spring keeps its normal force (it is a
+  closed broken spring: unilateral contact) and keeps its shear force up to residual friction, Fn·tanφ_r;
+  brittle (no softening: the crushed rock goes on carrying the pressure);
 - brittle: the spring breaks at once (tension first, then shear);
 - linear softening (Y21–Y22): past the strength the force follows the strength, which
   decreases with the opening (slip) increment at the rate ``slope`` [Pa/m] until it
@@ -29,6 +35,7 @@ import warp as wp
 INTACT = 0
 TENSILE = 1
 SHEAR = 2
+CRUSHED = 3
 
 vec5d = wp.types.vector(length=5, dtype=wp.float64)
 
@@ -58,9 +65,9 @@ def spring_update_intact(
     dn: wp.float64, ds: wp.float64,
     kn: wp.float64, ks: wp.float64, ac: wp.float64,
     tan_phi: wp.float64, tan_phi_r: wp.float64,
-    slope_t: wp.float64, slope_c: wp.float64, breakable: wp.int32,
+    slope_t: wp.float64, slope_c: wp.float64, breakable: wp.int32, crush: wp.float64,
 ):
-    """Advance an intact spring by opening dn and slip ds [m].
+    """Advance an intact spring by opening dn and slip ds [m]; crush: crushing strength σ_cr [Pa], 0 for none.
 
     Returns (Fn, Fs, T, c, mode) with forces [N/m], current strengths [Pa] and the mode code.
     """
@@ -75,6 +82,9 @@ def spring_update_intact(
             if t_new > zero:
                 return vec5d(-t_new * ac, fs, t_new, c_str, wp.float64(0.0))
         return vec5d(zero, zero, zero, zero, wp.float64(1.0))
+    if crush > zero and fn >= crush * ac:
+        cap = fn * tan_phi_r
+        return vec5d(fn, wp.clamp(fs, -cap, cap), zero, zero, wp.float64(3.0))
     limit = fn * tan_phi + c_str * ac
     if wp.abs(fs) >= limit:
         sgn = wp.sign(fs)
@@ -122,7 +132,8 @@ def spring_dashpot(dv: wp.vec2d, n: wp.vec2d, t: wp.vec2d, kn: wp.float64, ks: w
 
 
 # ----------------------------------------------------------------------------- NumPy twins
-def np_spring_update_intact(fn, fs, t_str, c_str, dn, ds, kn, ks, ac, tan_phi, tan_phi_r, slope_t, slope_c, breakable=1):
+def np_spring_update_intact(fn, fs, t_str, c_str, dn, ds, kn, ks, ac, tan_phi, tan_phi_r, slope_t, slope_c, breakable=1,
+                            crush=0.0):
     """NumPy twin of :func:`spring_update_intact` (scalars); returns (Fn, Fs, T, c, mode)."""
     fn = fn - kn * dn
     fs = fs - ks * ds
@@ -134,6 +145,9 @@ def np_spring_update_intact(fn, fs, t_str, c_str, dn, ds, kn, ks, ac, tan_phi, t
             if t_new > 0.0:
                 return -t_new * ac, fs, t_new, c_str, INTACT
         return 0.0, 0.0, 0.0, 0.0, TENSILE
+    if crush > 0.0 and fn >= crush * ac:
+        cap = fn * tan_phi_r
+        return fn, min(max(fs, -cap), cap), 0.0, 0.0, CRUSHED
     limit = fn * tan_phi + c_str * ac
     if abs(fs) >= limit:
         sgn = math.copysign(1.0, fs) if fs != 0.0 else 0.0
@@ -165,6 +179,11 @@ def np_spring_dashpot(dv, n, t, kn, ks, mi, mj, zeta):
 def tensile_failure(fn: float, t_str: float, ac: float) -> bool:
     """Eq. (Y19) as a predicate: tensile normal stress −Fn/Ac at or above T."""
     return -fn >= t_str * ac
+
+
+def crushing_failure(fn: float, crush: float, ac: float) -> bool:
+    """The compression cap as a predicate: compressive normal stress Fn/Ac at or above σ_cr (σ_cr > 0)."""
+    return crush > 0.0 and fn >= crush * ac
 
 
 def shear_failure(fn: float, fs: float, c_str: float, tan_phi: float, ac: float) -> bool:

@@ -239,6 +239,7 @@ class ModelBuilder:
             tan_phi_r=math.tan(math.radians(rock.residual_friction)),
             slope_t=self.slope_t, slope_c=self.slope_c,
             breakable=0 if rock.unbreakable else 1,
+            crush=float(rock.crushing_strength or 0.0),
             q_quad=rock.bulk_viscosity_quadratic, q_lin=rock.bulk_viscosity_linear,
             spring_damping=rock.spring_damping,
             node_mass=arr(h["node_mass"], wp.float64),

@@ -34,6 +34,7 @@ class Model:
     pair_law: per-spring (tanφ, tanφ_r, slope_t, slope_c), [P] vec4d, read only when per_pair_law = 1 (a model
         with joints, geometry.joints); otherwise a 1-element placeholder and the scalars tan_phi.. slope_c apply
     host["pair_joint"]: joint set of each spring (−1 rock), [P]; host["pair_mode0"]: initial pair_mode (open joints)
+    crush: compressive cap of the springs σ_cr [Pa] (rock.crushing_strength), 0 for none; one scalar for all springs
     spring_damping: dashpot ratio ζ beside every loaded spring [-] (materials.interface.spring_dashpot)
     q_quad, q_lin: coefficients of the blocks' artificial bulk viscosity [-] (materials/artificial_viscosity.py)
     ledge_n0, ledge_n1: nodes of loaded boundary edges (n0→n1 runs counter-clockwise around the element), [L]
@@ -51,6 +52,7 @@ class Model:
     slope_t: float
     slope_c: float
     breakable: int
+    crush: float  # compressive cap σ_cr of the springs [Pa], 0: none (rock.crushing_strength)
     node_mass: wp.array
     node_X: wp.array
     node_pairs: wp.array

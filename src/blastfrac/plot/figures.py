@@ -19,6 +19,8 @@ def _plt():
 
 TENSILE_COLOR = "#d62728"
 SHEAR_COLOR = "#1f77b4"
+CRUSHED_COLOR = "#8c564b"          # compressive cap (rock.crushing_strength)
+CRUSHED_DETACHED_COLOR = "#c49c94"
 
 
 TENSILE_DETACHED_COLOR = "#f0a8a8"
@@ -62,7 +64,8 @@ def fracture_pattern(path: Path, x: np.ndarray, seg: np.ndarray, mode: np.ndarra
     det = np.zeros(len(seg), bool) if detached is None else np.asarray(detached, bool)
     styles = ((1, False, TENSILE_COLOR, "tensile"), (2, False, SHEAR_COLOR, "shear"),
               (1, True, TENSILE_DETACHED_COLOR, "tensile, detached"),
-              (2, True, SHEAR_DETACHED_COLOR, "shear, detached"))
+              (2, True, SHEAR_DETACHED_COLOR, "shear, detached"),
+              (3, False, CRUSHED_COLOR, "crushed"), (3, True, CRUSHED_DETACHED_COLOR, "crushed, detached"))
     for code, off, color, label in styles:
         s = seg[(mode == code) & (det == off)]
         if len(s):
@@ -160,7 +163,7 @@ def gas_particles(path: Path, xp: np.ndarray, p: np.ndarray, x: np.ndarray, seg:
     from matplotlib.colors import LogNorm
 
     fig, ax = plt.subplots(figsize=(7, 6), dpi=150)
-    for code, color in ((1, TENSILE_COLOR), (2, SHEAR_COLOR)):
+    for code, color in ((1, TENSILE_COLOR), (2, SHEAR_COLOR), (3, CRUSHED_COLOR)):
         s = seg[mode == code]
         if len(s):
             ax.add_collection(LineCollection(x[s], colors=color, linewidths=0.6))
@@ -212,6 +215,8 @@ def fracture_degree_zones(path: Path, t: np.ndarray, cols: dict[str, np.ndarray]
         pre = "" if name == "model" else f"{name}:"
         ax.plot(ts, cols[f"{pre}D_tensile"], color=TENSILE_COLOR, label="tensile")
         ax.plot(ts, cols[f"{pre}D_shear"], color=SHEAR_COLOR, label="shear")
+        if np.any(np.asarray(cols.get(f"{pre}D_crushed", [0.0])) > 0):
+            ax.plot(ts, cols[f"{pre}D_crushed"], color=CRUSHED_COLOR, label="crushed")
         ax.plot(ts, cols[f"{pre}D"], color="k", lw=0.8, ls="--", label="total")
         ax.set_title(name, fontsize=9)
         ax.grid(alpha=0.3)

@@ -177,6 +177,13 @@ class RockConfig(_Strict):
     residual_friction_angle: float | None = Field(
         None, ge=0, lt=90, description="Friction angle of broken interfaces and block contact [deg]; default φ."
     )
+    crushing_strength: float | None = Field(
+        None, gt=0, le=1e11, description="Compressive cap of the springs σ_cr [Pa] (not in the paper): a spring whose "
+        "normal compression reaches σ_cr breaks in the 'crushed' mode and goes on as a closed broken spring (it keeps "
+        "its normal force, its shear falls to residual friction). Mohr–Coulomb springs cannot fail in uniaxial "
+        "strain at usual friction angles, so without it a blast crushes only by hoop tension and shear near the "
+        "wall. None: no cap (the paper's law). See docs/scenario.md, 'Crushing'.",
+    )
     tensile_fracture_energy: float | None = Field(
         None, gt=0, description="Mode I fracture energy G_fI [J/m²]; enables linear tension softening."
     )
