@@ -159,3 +159,7 @@ def test_crushing_cap_breaks_exactly_the_interfaces_the_continuum_loads_past_it(
     assert crushed[must].mean() >= 0.99
     assert crushed[must_not].sum() == 0
     assert not ((mode == 1) | (mode == 2))[band].any()
+    # reported apart: D_crushed counts the crushed springs (two per interface) over all springs, and D all modes
+    fd = sim.fracture.sample(sim.state.pair_mode.numpy())
+    assert fd["D_crushed"] == pytest.approx((mode == 3).sum() / mode.size, rel=1e-12)
+    assert fd["D"] == pytest.approx((mode > 0).sum() / mode.size, rel=1e-12)
