@@ -21,9 +21,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path[:0] = [str(HERE.parents[1] / "tests" / "verification")]
 
-from test_coupled_blast import R_B, ROCK, crushed_zone_bracket  # noqa: E402
+from test_coupled_blast import ROCK, crushed_zone_bracket, small_blast  # noqa: E402
 
-from blastfrac.scenario import scenario_from_dict  # noqa: E402
 from blastfrac.simulation import Simulation  # noqa: E402
 
 UCS = 2 * ROCK["cohesion"] * math.cos(math.radians(ROCK["friction_angle"])) / (
@@ -31,24 +30,7 @@ UCS = 2 * ROCK["cohesion"] * math.cos(math.radians(ROCK["friction_angle"])) / (
 
 
 def blast(factor: float, scale: float, out: Path) -> dict:
-    h = R_B / 5 / scale
-    rock = {**ROCK, "bulk_viscosity_linear": 0.02, "bulk_viscosity_quadratic": 1.5, "spring_damping": 0.15,
-            "tensile_fracture_energy": 50.0, "shear_fracture_energy": 500.0}
-    if factor > 0:
-        rock["crushing_strength"] = factor * UCS
-    sc = scenario_from_dict({
-        "title": f"small coupled blast, cap {factor:g} UCS, mesh scale {scale:g}",
-        "simulation": {"end_time": 20e-6, "progress": False},
-        "output": {"paraview": False, "figures": True, "interval": 5e-6},
-        "rock": rock,
-        "geometry": {"domain": {"type": "rectangle", "width": 0.12, "height": 0.12}, "mesh_size": 8 * R_B / 5,
-                     "mesh_size_near": h, "refinement_distance": 0.036,
-                     "boreholes": [{"center": [0.0, 0.0], "radius": R_B}]},
-        "boundaries": {s: {"type": "viscous"} for s in ("left", "right", "top", "bottom")},
-        "explosive": {"name": "emulsion", "charges": [{"kind": "circle", "center": [0.0, 0.0], "radius": R_B}],
-                      "grid": {"cell_size": h, "points_per_cell": 2,
-                               "bounds": [[-6 * R_B, -6 * R_B], [6 * R_B, 6 * R_B]]}},
-    })
+    sc = small_blast({"crushing_strength": factor * UCS} if factor > 0 else None, scale=scale, paraview=False)
     s = Simulation(sc, out_dir=out).run()
     c = s["cracks"][0]
     return {"factor": factor, "scale": scale, "rc": c["crushed_zone_radius_over_rb"], "radial": c["radial_crack_count"],
