@@ -18,9 +18,9 @@ import warp as wp
 from .._warp import Launcher
 from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
-from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEATED, ACC_SIZE, ACC_STORED,
+from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEAT_NEW, ACC_HEATED, ACC_SIZE, ACC_STORED,
                               account_rock_work_and_clear, accumulate_gas_contact_work, add_reactions_with_work,
-                              book_contact_heat, collect_exposed_elements, eval_particle_edge_contact,
+                              collect_exposed_elements, eval_particle_edge_contact,
                               heat_gas_from_contacts)
 
 
@@ -191,7 +191,6 @@ class GasRockCoupler:
         if self.contact_heating:                          # the contacts' dissipation so far heats the gas in contact
             self._launch(heat_gas_from_contacts, dim=self.mpm.n, inputs=[self.acc, self.diss_p],
                          outputs=[self.mpm.ie], device=self.model.device)
-            self._launch(book_contact_heat, dim=1, inputs=[], outputs=[self.acc], device=self.model.device)
 
     def energies(self) -> dict[str, float]:
         """contact_energy: work absorbed by the contacts so far, −∫(P_gas + P_rock) dt [J/m] with the power put into
@@ -201,5 +200,6 @@ class GasRockCoupler:
         contacts now [-]. The work of the last step is in up to its first half (the second half is added with the
         next step's forces)."""
         a = self.acc.numpy()
-        return {"contact_energy": float(a[ACC_ABSORBED]), "contact_penalty": float(a[ACC_STORED]),
-                "contacts": int(a[ACC_CONTACTS]), "contact_heat": float(a[ACC_HEATED])}
+        # the heat handed over at the last step is booked at the next one (account_rock_work_and_clear)
+        return {"contact_energy": float(a[ACC_ABSORBED] - a[ACC_HEAT_NEW]), "contact_penalty": float(a[ACC_STORED]),
+                "contacts": int(a[ACC_CONTACTS]), "contact_heat": float(a[ACC_HEATED] + a[ACC_HEAT_NEW])}

@@ -15,7 +15,8 @@ ACC_STORED = wp.constant(1)     # penalty energy ½k_c·δ² stored in the conta
 ACC_CONTACTS = wp.constant(2)   # number of particle–element contacts at this step [-]
 ACC_DISS = wp.constant(3)       # Σ over gas points of the contacts' dissipation rate at this step [W/m]
 ACC_HEATED = wp.constant(4)     # contact dissipation handed to the gas as heat since the start [J/m]
-ACC_SIZE = 5
+ACC_HEAT_NEW = wp.constant(5)   # heat handed over at the last step, booked at the next (heat_gas_from_contacts) [J/m]
+ACC_SIZE = 6
 
 
 @wp.func
@@ -273,12 +274,19 @@ def account_rock_work_and_clear(
 ):
     """acc[ABSORBED] −= w·f·v for the last step's reactions f [N/m] at the rock's present velocities v [m/s] (their
     second half, w = ½Δt [s]), then f_react = 0 for this step's; and the per-step books acc[STORED] and
-    acc[CONTACTS] start again from 0 (thread 0: the contact kernel fills them after this one)."""
+    acc[CONTACTS] start again from 0 (thread 0: the contact kernel fills them after this one). Thread 0 also books
+    the heat the last step handed to the gas (acc[HEAT_NEW], heat_gas_from_contacts): it leaves the contacts' book
+    (absorbed −= it, atomically, beside the other threads' adds) into acc[HEATED], so the budget is unchanged."""
     i = wp.tid()
     if i == 0:
         acc[ACC_STORED] = wp.float64(0.0)
         acc[ACC_CONTACTS] = wp.float64(0.0)
         acc[ACC_DISS] = wp.float64(0.0)
+        q = acc[ACC_HEAT_NEW]
+        if q != wp.float64(0.0):
+            wp.atomic_add(acc, ACC_ABSORBED, -q)
+            acc[ACC_HEATED] = acc[ACC_HEATED] + q
+            acc[ACC_HEAT_NEW] = wp.float64(0.0)
     f = f_react[i]
     if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
         if w != wp.float64(0.0):
@@ -325,21 +333,15 @@ def contact_heat(acc: wp.array(dtype=wp.float64)):
 def heat_gas_from_contacts(acc: wp.array(dtype=wp.float64), diss_p: wp.array(dtype=wp.float64),
                            ie: wp.array(dtype=wp.float64)):
     """ie_p += Q·q_p / Σq [J/m]: the contacts' dissipation Q (:func:`contact_heat`) heats the gas points in contact,
-    in proportion to their contacts' dissipation rates q_p [W/m] this step (coupling.contact_heating)."""
+    in proportion to their contacts' dissipation rates q_p [W/m] this step (coupling.contact_heating). Each share
+    is added to acc[HEAT_NEW] (read by no thread here), which the next step's account_rock_work_and_clear books:
+    one launch fewer than a one-thread booking kernel, and no thread writes what another reads."""
     p = wp.tid()
     q = diss_p[p]
     if q <= wp.float64(0.0):
         return
     Q = contact_heat(acc)
     if Q > wp.float64(0.0):
-        ie[p] = ie[p] + Q * (q / acc[ACC_DISS])
-
-
-@wp.kernel
-def book_contact_heat(acc: wp.array(dtype=wp.float64)):
-    """One thread, after :func:`heat_gas_from_contacts`: the heat leaves the contacts' book (absorbed −= Q) and is
-    counted in acc[HEATED], so the energy budget is unchanged."""
-    Q = contact_heat(acc)
-    if Q > wp.float64(0.0):
-        acc[ACC_ABSORBED] = acc[ACC_ABSORBED] - Q
-        acc[ACC_HEATED] = acc[ACC_HEATED] + Q
+        share = Q * (q / acc[ACC_DISS])
+        ie[p] = ie[p] + share
+        wp.atomic_add(acc, ACC_HEAT_NEW, share)
