@@ -108,13 +108,14 @@ def table(out: Path) -> None:
                 v += f" ({r['detached_long']})"
             cells.append(v)
         print(f"| {n} | {r['elements']} | " + " | ".join(cells) + " |")
-    print("\nhalved against shipped [%]:")
+    print("\nhalved against shipped, quarter against halved [%]:")
     for n, b in rows.items():
-        ship = n.replace("_half", "_ship")
-        if "_half" not in n or ship not in rows:
+        coarser = n.replace("_half", "_ship") if "_half" in n else n.replace("_quarter", "_half")
+        if coarser == n or coarser not in rows:
             continue
-        a = rows[ship]
-        print(f"| {n} vs {ship} | " + " | ".join(f"{100 * (b[k] / a[k] - 1):+.0f}" for k, _, _ in COLS if k != "budget") + " |")
+        a = rows[coarser]
+        print(f"| {n} vs {coarser} | " + " | ".join(f"{100 * (b[k] / a[k] - 1):+.0f}" for k, _, _ in COLS if k != "budget")
+              + " |")
     patterns(out, rows)
     ring_table(out)
 
@@ -125,8 +126,20 @@ def patterns(out: Path, rows: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    hom = [n for n in ("hom_ship", "hom_half", "hom_quarter") if n in rows and (out / n / "fracture_pattern.png").exists()]
+    if "hom_quarter" in hom:
+        fig, ax = plt.subplots(1, len(hom), figsize=(5 * len(hom), 5.3), squeeze=False)
+        for a, name in zip(ax[0], hom):
+            a.axis("off")
+            a.imshow(plt.imread(out / name / "fracture_pattern.png"))
+            r = rows[name]
+            a.set_title(f"{name} ({r['elements']} blocks): longest {r['longest']:.0f} mm, r90 {r['r90']:.0f} mm",
+                        fontsize=9)
+        fig.tight_layout()
+        fig.savefig(HERE / "mesh_convergence_patterns.png", dpi=90)
+        print(f"wrote {HERE / 'mesh_convergence_patterns.png'}")
     cols = [c for c in ("hom", "iid", "wl") if f"{c}_ship" in rows or f"{c}_ship_s0" in rows]
-    if not cols:
+    if len(cols) < 3:                       # the shipped figure has all three: do not overwrite it with fewer
         return
     fig, ax = plt.subplots(2, len(cols), figsize=(5 * len(cols), 10), squeeze=False)
     for j, c in enumerate(cols):
