@@ -14,7 +14,7 @@ Laws (METHOD.md §1.3, the paper's Eqs. 17–22):
   rock close the envelope the same way (a compressive cap). A crushed spring keeps its normal force (it is a
   closed broken spring: unilateral contact) and keeps its shear force up to residual friction, Fn·tanφ_r;
   brittle (no softening: the crushed rock goes on carrying the pressure);
-- brittle: the spring breaks at once (tension first, then shear);
+- brittle: the spring breaks at once (tension first, then the crushing cap, then shear);
 - linear softening (Y21–Y22): past the strength the force follows the strength, which
   decreases with the opening (slip) increment at the rate ``slope`` [Pa/m] until it
   reaches zero; the spring then breaks;
