@@ -15,7 +15,8 @@ prints the peak radial compression and hoop tension.
 
 Cases: 'hom' = the shipped homogeneous rock; 'iid' = Weibull m = 5 on T and c (correlated), one draw per
 interface whatever its length; 'wl' = the same with weakest-link size scaling, reference_length 5 mm; 'wl3' =
-'wl' with m = 3.
+'wl' with m = 3; 'cf' = Weibull m = 5 (T and c) spatially correlated over ℓ = 3 mm
+(rock.heterogeneity.correlation_length), identical on both meshes for one seed.
 'ship' = the shipped mesh, 'half' = mesh_size 5 mm and mesh_size_near 0.5 mm (the MPM cell is 0.5 mm on both),
 'quarter' = 2.5 mm and 0.25 mm (hom only; about 25 minutes on 2 cores).
 """
@@ -39,6 +40,10 @@ M = 5.0
 L_REF = 0.005
 IID = [f"rock.heterogeneity.weibull_modulus={M}"]
 WL = IID + [f"rock.heterogeneity.reference_length={L_REF}"]
+#: the spatially correlated field (rock.heterogeneity.correlation_length): the same strengths at the same place
+#: on both meshes, so one seed compares the meshes like with like
+ELL = 0.003
+CF = IID + [f"rock.heterogeneity.correlation_length={ELL}"]
 
 #: name → overrides, in the order of the study (the most informative first)
 CASES: dict[str, list[str]] = {
@@ -56,6 +61,10 @@ CASES: dict[str, list[str]] = {
     "iid_half_s1": IID + HALF + ["simulation.seed=1"],
     "wl3_ship_s0": [x.replace(f"={M}", "=3.0") for x in WL],
     "wl3_half_s0": [x.replace(f"={M}", "=3.0") for x in WL] + HALF,
+    "cf_ship_s0": CF,
+    "cf_half_s0": CF + HALF,
+    "cf_ship_s1": CF + ["simulation.seed=1"],
+    "cf_half_s1": CF + HALF + ["simulation.seed=1"],
 }
 
 

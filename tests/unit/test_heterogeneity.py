@@ -387,3 +387,113 @@ def test_reference_length_is_validated_and_resolved():
     assert interface_factors(sc({"reference_length": 0.005}).rock.heterogeneity, 10, 0) == {}
     with pytest.raises(ValueError, match="reference_length"):
         interface_factors(het_cfg(5.0, 0.005), 10, 0)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# Spatially correlated field (correlation_length, issue 11 item 3): a Gaussian field of covariance
+# exp(−r²/(2ℓ²)) sampled at the interface midpoints, mapped onto the Weibull marginal
+
+def gaussian_covariance_bounds(r: float, ell: float, modes: int) -> tuple[float, float]:
+    """The ensemble covariance exp(−r²/(2ℓ²)) of the field at lag r, and the standard deviation of a
+    realisation's spatial covariance (1/N)Σcos(k_j·r), k_j ~ N(0, I/ℓ²): √(Var[cos(k·r)]/N), with
+    E[cos²(k·r)] = (1 + exp(−2r²/ℓ²))/2."""
+    rho = math.exp(-r**2 / (2 * ell**2))
+    var = 0.5 * (1.0 + math.exp(-2 * r**2 / ell**2)) - rho**2
+    return rho, math.sqrt(var / modes)
+
+
+def test_correlated_field_has_unit_variance_and_the_gaussian_covariance():
+    from blastfrac.model.heterogeneity import FOURIER_MODES, GaussianField, stream
+
+    ell = 0.004
+    g = GaussianField(ell, stream(0, "tensile_strength"))
+    # a 400ℓ square sampled every ℓ/2: spatial averages stand for the ensemble's
+    s = np.arange(0.0, 400 * ell, 0.5 * ell)
+    xx, yy = np.meshgrid(s, s, indexing="ij")
+    p = np.stack([xx.ravel(), yy.ravel()], 1)
+    v = g(p).reshape(xx.shape)
+    print(f"\nmean {v.mean():+.4f}, variance {v.var():.4f}")
+    assert abs(v.mean()) < 0.02 and abs(v.var() - 1.0) < 0.02
+    for lag in (1, 2, 4, 8):                      # lags of ℓ/2 … 4ℓ along x and along y
+        r = 0.5 * ell * lag
+        rho, sd = gaussian_covariance_bounds(r, ell, FOURIER_MODES)
+        cx = np.mean(v[lag:, :] * v[:-lag, :])
+        cy = np.mean(v[:, lag:] * v[:, :-lag])
+        print(f"r = {r / ell:.1f} ℓ: covariance x {cx:.4f}, y {cy:.4f}, exp(−r²/2ℓ²) = {rho:.4f} (± {sd:.4f})")
+        for c in (cx, cy):
+            assert abs(c - rho) < 4 * sd + 0.02
+
+
+def test_gaussian_to_weibull_map_gives_the_weibull_distribution():
+    from scipy.stats import kstest
+
+    from blastfrac.model.heterogeneity import weibull_from_gaussian
+
+    g = np.random.default_rng(3).standard_normal(200_000)
+    for m in (2.0, 5.0, 10.0):
+        w = weibull_from_gaussian(g, m)
+        ks = kstest(w, lambda x: weibull_cdf(x, m))
+        se = weibull_cv(m) / math.sqrt(len(w))
+        print(f"m = {m:g}: mean {w.mean():.4f} (± {se:.4f}), CV {w.std() / w.mean():.4f} vs {weibull_cv(m):.4f}, "
+              f"KS p = {ks.pvalue:.3f}")
+        assert ks.pvalue > 0.01 and abs(w.mean() - 1.0) < 4 * se
+        assert np.all(np.diff(w[np.argsort(g)]) >= 0.0)        # monotone: the quantile is kept
+    # far upper tail through Φ(−g): finite and increasing where 1 − Φ(g) underflows in double
+    w = weibull_from_gaussian(np.array([8.0, 12.0, 38.0, 40.0]), 5.0)
+    assert np.all(np.isfinite(w)) and np.all(np.diff(w) > 0)
+
+
+def test_correlated_field_is_the_same_at_the_same_place_on_two_meshes():
+    """Same seed, two meshes of one domain (h and h/2): interfaces whose midpoints lie within ℓ/20 of each
+    other carry factors that differ by at most the field's variation over that distance, whereas the i.i.d.
+    field's factors are uncorrelated; neighbours within ℓ/4 on one mesh are strongly correlated."""
+    from scipy.spatial import cKDTree
+
+    ell = 0.01
+    het = {"weibull_modulus": 5.0, "correlation_length": ell}
+    coarse = build(heterogeneity=het, geometry={**BIG, "mesh_size": 0.008})
+    fine = build(heterogeneity=het, geometry=BIG)
+
+    def mids(b):
+        X, s1 = b.host["node_X"], b.topology.iface_slots[:, 0]
+        nb = 3 * (s1 // 3) + (s1 % 3 + 1) % 3
+        return 0.5 * (X[s1] + X[nb]), b.host["pair_t0"][0::2] / T_MEAN
+
+    (pc, wc), (pf, wf) = mids(coarse), mids(fine)
+    d, j = cKDTree(pf).query(pc)
+    near = d < ell / 20
+    assert near.sum() > 100
+    corr = np.corrcoef(wc[near], wf[j[near]])[0, 1]
+    iid = {"weibull_modulus": 5.0}
+    wci, wfi = (b.host["pair_t0"][0::2] / T_MEAN for b in (build(heterogeneity=iid, geometry={**BIG, "mesh_size": 0.008}),
+                                                            build(heterogeneity=iid, geometry=BIG)))
+    corr_iid = np.corrcoef(wci[near], wfi[j[near]])[0, 1]
+    # within one mesh: pairs of interfaces closer than ℓ/4
+    pairs = cKDTree(pf).query_pairs(ell / 4, output_type="ndarray")
+    corr_nb = np.corrcoef(wf[pairs[:, 0]], wf[pairs[:, 1]])[0, 1]
+    rho_nb = math.exp(-(ell / 8) ** 2 / (2 * ell**2))          # at a typical lag ℓ/8 of those pairs
+    print(f"\n{near.sum()} coincident interfaces: correlation {corr:.4f} (i.i.d. {corr_iid:+.4f}); "
+          f"{len(pairs)} pairs within ℓ/4: {corr_nb:.3f} (Gaussian covariance at ℓ/8: {rho_nb:.3f})")
+    assert corr > 0.99 and abs(corr_iid) < 0.2 and corr_nb > 0.9
+    # the builder's strengths are the field at the midpoints exactly
+    from blastfrac.model.heterogeneity import correlated_draw
+
+    np.testing.assert_allclose(wf, correlated_draw(5.0, pf, ell, 0), rtol=1e-13)
+    # and the mean over the 0.2 m square (20 ℓ a side) is the rock's value within the field's own scatter
+    assert abs(wf.mean() - 1.0) < 0.1
+
+
+def test_correlation_length_is_validated_and_resolved():
+    def sc(het):
+        return scenario_from_dict({"rock": {"heterogeneity": het},
+                                   "geometry": {"domain": {"type": "rectangle", "width": 0.02, "height": 0.02},
+                                                "mesh_size": 0.005}})
+
+    for het, msg in [({"weibull_modulus": 5.0, "correlation_length": 0.0},
+                      r"rock\.heterogeneity\.correlation_length: .*greater than 0"),
+                     ({"weibull_modulus": 5.0, "correlation_length": 0.01, "reference_length": 0.005},
+                      "exclusive")]:
+        with pytest.raises(ScenarioError, match=msg):
+            sc(het)
+    r = resolved_dict(sc({"weibull_modulus": 5.0, "correlation_length": 0.003}))["rock"]["heterogeneity"]
+    assert r["correlation_length"] == 0.003

@@ -114,8 +114,12 @@ def run(args) -> int:
     if het.active:                            # Weibull spring properties (docs/heterogeneity.md)
         from ..model.heterogeneity import weibull_cv
 
-        scaling = (f", weakest-link scaling to L_ref = {het.reference_length:.4g} m" if het.reference_length
-                   else ", no size scaling")
+        if het.correlation_length:
+            scaling = f", spatially correlated over ℓ = {het.correlation_length:.4g} m"
+        elif het.reference_length:
+            scaling = f", weakest-link scaling to L_ref = {het.reference_length:.4g} m"
+        else:
+            scaling = ", i.i.d. per interface, no size scaling"
         rows.append(("heterogeneity", f"Weibull m = {het.weibull_modulus:g} (CV {weibull_cv(het.weibull_modulus):.3f}) "
                      f"on {', '.join(het.fields)}{', correlated' if het.correlated else ''}{scaling}, "
                      f"seed {sc.simulation.seed}"))

@@ -61,8 +61,10 @@ class ModelBuilder:
             ks_a = kn_a.copy()
         # heterogeneous rock: one unit-mean Weibull factor per interface and property, shared by the
         # interface's two springs (model/heterogeneity.py), times (L_ref/L_q)^(1/m) on the strengths with
-        # reference_length (weakest-link size scaling); {} for a homogeneous rock
-        self.factors = interface_factors(rock.heterogeneity, len(L), sc.simulation.seed, L)
+        # reference_length (weakest-link size scaling), or sampled at the midpoints from a field correlated
+        # over correlation_length; {} for a homogeneous rock
+        self.factors = interface_factors(rock.heterogeneity, len(L), sc.simulation.seed, L,
+                                           0.5 * (X[na] + X[nb]))
         kn_min_nominal = float(kn_a.min()) if len(kn_a) else 1.0
         ks_min_nominal = float(ks_a.min()) if len(ks_a) else 1.0
         if "stiffness" in self.factors:

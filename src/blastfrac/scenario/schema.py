@@ -120,6 +120,13 @@ class HeterogeneityConfig(_Strict):
         "tensile_strength and cohesion are then the mean strengths of an interface of length reference_length. "
         "Ignored while weibull_modulus is None.",
     )
+    correlation_length: float | None = Field(
+        None, gt=0, description="Spatial correlation length ℓ of the factors [m], > 0; None (default) = an "
+        "independent draw per interface. Set: the factor is a function of position, a Gaussian random field "
+        "of covariance exp(−r²/(2ℓ²)) mapped onto the Weibull marginal and sampled at each interface's "
+        "midpoint, the same at the same place on any mesh (docs/heterogeneity.md \"Correlated field\"). "
+        "Not together with reference_length. Ignored while weibull_modulus is None.",
+    )
 
     @field_validator("fields")
     @classmethod
@@ -135,6 +142,14 @@ class HeterogeneityConfig(_Strict):
         if m is not None and "stiffness" in self.fields and m <= 1.0:
             raise ValueError(f"weibull_modulus: {m} is too small for 'stiffness' in fields: the spring compliance "
                              "1/k of a Weibull stiffness has no finite mean for m <= 1 (give m > 1)")
+        return self
+
+    @model_validator(mode="after")
+    def _one_length_rule(self) -> "HeterogeneityConfig":
+        if self.correlation_length is not None and self.reference_length is not None:
+            raise ValueError("correlation_length and reference_length are exclusive: the weakest-link scaling "
+                             "treats every interface as an independent link, a correlated field does not "
+                             "(give one of them)")
         return self
 
     @property
