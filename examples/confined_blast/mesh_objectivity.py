@@ -16,7 +16,9 @@ prints the peak radial compression and hoop tension.
 Cases: 'hom' = the shipped homogeneous rock; 'iid' = Weibull m = 5 on T and c (correlated), one draw per
 interface whatever its length; 'wl' = the same with weakest-link size scaling, reference_length 5 mm; 'wl3' =
 'wl' with m = 3; 'cf' = Weibull m = 5 (T and c) spatially correlated over ℓ = 3 mm
-(rock.heterogeneity.correlation_length), identical on both meshes for one seed.
+(rock.heterogeneity.correlation_length), identical on both meshes for one seed; 'gv2'/'gvb' = the halved mesh
+with G_fII (gv2) or both fracture energies (gvb) halved; 'fb12'/'fb25' = rock.fracture_band_width 1.2 / 2.5 mm;
+'farq_near1' / 'farq_near05' = the quarter mesh's far size (2.5 mm) with the shipped / halved wall size.
 'ship' = the shipped mesh, 'half' = mesh_size 5 mm and mesh_size_near 0.5 mm (the MPM cell is 0.5 mm on both),
 'quarter' = 2.5 mm and 0.25 mm (hom only; about 25 minutes on 2 cores).
 """
@@ -61,6 +63,18 @@ CASES: dict[str, list[str]] = {
     "iid_half_s1": IID + HALF + ["simulation.seed=1"],
     "wl3_ship_s0": [x.replace(f"={M}", "=3.0") for x in WL],
     "wl3_half_s0": [x.replace(f"={M}", "=3.0") for x in WL] + HALF,
+    # the shipped energies halved on the halved mesh: what a fracture energy per unit volume would give
+    "gv2_half": HALF + ["rock.shear_fracture_energy=250"],
+    "gvb_half": HALF + ["rock.shear_fracture_energy=250", "rock.tensile_fracture_energy=25"],
+    # the fracture band (rock.fracture_band_width): the share h̄/w_c of G_f on blocks thinner than w_c
+    "fb12_ship": ["rock.fracture_band_width=0.0012"],
+    "fb12_half": HALF + ["rock.fracture_band_width=0.0012"],
+    "fb25_ship": ["rock.fracture_band_width=0.0025"],
+    "fb25_half": HALF + ["rock.fracture_band_width=0.0025"],
+    # a far mesh that carries the wave (2.5 mm everywhere beyond the refinement, as on the quarter mesh) with
+    # the shipped (1 mm) or the halved (0.5 mm) wall mesh: the near-wall refinement alone
+    "farq_near1": ["geometry.mesh_size=0.0025"],
+    "farq_near05": ["geometry.mesh_size=0.0025", "geometry.mesh_size_near=0.0005"],
     "cf_ship_s0": CF,
     "cf_half_s0": CF + HALF,
     "cf_ship_s1": CF + ["simulation.seed=1"],
@@ -68,14 +82,15 @@ CASES: dict[str, list[str]] = {
 }
 
 
-def run(names: list[str], out: Path) -> None:
+def run(names: list[str], out: Path, threads: int = 2) -> None:
     for name in names:
         d = out / name
         if (d / "summary.json").exists():
             print(f"{name}: done already")
             continue
         cmd = [str(Path(sys.executable).with_name("blastfrac")), "run", str(SCENARIO), "--out", str(d),
-               "--set", "simulation.progress=false", "--set", "output.interval=9e-5"]
+               "--set", "simulation.progress=false", "--set", "output.interval=9e-5",
+               "--set", f"simulation.threads={threads}"]
         for o in CASES[name]:
             cmd += ["--set", o]
         print(" ".join(cmd), flush=True)
@@ -255,13 +270,19 @@ WAVE = {"ship": [], "half": HALF[:2], "ship_novisc": ["rock.bulk_viscosity_linea
         "half_novisc": HALF[:2] + ["rock.bulk_viscosity_linear=0", "rock.bulk_viscosity_quadratic=0"]}
 
 
-def wave(out: Path) -> None:
+def wave(out: Path, names: list[str] | None = None) -> None:
     """The outgoing wave in unbreakable rock on both meshes: radial and hoop stress at +x monitors (5 mm
-    averaging discs), peak compression and peak hoop tension per radius."""
+    averaging discs), peak compression and peak hoop tension per radius; beside each run the converged elastic
+    answer to its own wall pressure (analysis/radial_wave.py: 1D axisymmetric, dr = 0.02 mm, the same 5 mm
+    disc averages), so the table says how much of the pulse each mesh carries to each radius."""
     import csv
 
     import numpy as np
 
+    from blastfrac.analysis.radial_wave import radial_wave
+    from blastfrac.scenario import load_scenario
+
+    names = names or list(WAVE)
     w = out / "wave"
     w.mkdir(parents=True, exist_ok=True)
     scen = w / "scenario_P0_monitors.toml"
@@ -272,22 +293,37 @@ def wave(out: Path) -> None:
     scen.write_text(text)
     base = ["simulation.progress=false", "rock.unbreakable=true", "output.paraview=false", "output.figures=false",
             "output.monitor_interval=2e-7"]
-    for name, ov in WAVE.items():
+    for name in names:
         if not (w / name / "summary.json").exists():
             cmd = [str(Path(sys.executable).with_name("blastfrac")), "run", str(scen), "--out", str(w / name)]
-            for o in base + ov:
+            for o in base + WAVE[name]:
                 cmd += ["--set", o]
             subprocess.run(cmd, check=True)
-    print("| r [mm] | " + " | ".join(f"{n}: min σrr / max σθθ [MPa]" for n in WAVE) + " |")
-    data = {}
-    for name in WAVE:
-        with open(w / name / "monitors.csv") as f:
+
+    def table(rows):
+        with open(rows) as f:
             rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]
         head = [k.split(" [")[0] for k in rows[0]]
-        data[name] = {k: np.array(rows[1:], float)[:, i] for i, k in enumerate(head)}
-    for r in WAVE_R:
-        print(f"| {r} | " + " | ".join(f"{d[f'x{r}:sxx'].min() / 1e6:.0f} / {d[f'x{r}:syy'].max() / 1e6:+.0f}"
-                                       for d in data.values()) + " |")
+        return {k: np.array(rows[1:], float)[:, i] for i, k in enumerate(head)}
+
+    cols = []
+    for name in names:
+        d = table(w / name / "monitors.csv")
+        bp = table(w / name / "borehole_pressure.csv")
+        sc = load_scenario(w / name / "resolved.toml")
+        rk = sc.rock
+        ref = radial_wave(bp["time"], bp["hole0"], sc.geometry.boreholes[0].radius, rk.youngs_modulus,
+                          rk.poisson_ratio, rk.density, [], t_end=float(bp["time"][-1]), dr=2e-5,
+                          discs=[(r / 1000, 0.005) for r in WAVE_R])
+        cols.append((name, d, ref))
+    print("| r [mm] | " + " | ".join(f"{n}: min σrr / max σθθ [MPa] | 1D reference" for n, _, _ in cols) + " |")
+    print("|---|" + "---|---|" * len(cols))
+    for k, r in enumerate(WAVE_R):
+        cells = []
+        for _, d, ref in cols:
+            cells.append(f"{d[f'x{r}:sxx'].min() / 1e6:.0f} / {d[f'x{r}:syy'].max() / 1e6:+.0f}")
+            cells.append(f"{ref.disc_sxx[:, k].min() / 1e6:.0f} / {ref.disc_syy[:, k].max() / 1e6:+.0f}")
+        print(f"| {r} | " + " | ".join(cells) + " |")
 
 
 def main() -> None:
@@ -295,11 +331,12 @@ def main() -> None:
     p.add_argument("action", choices=["run", "table", "wave"])
     p.add_argument("cases", nargs="*", help="cases to run (default: all, in order)")
     p.add_argument("--out", type=Path, default=Path("out/mesh_objectivity"))
+    p.add_argument("--threads", type=int, default=2, help="simulation.threads of each run (1 to run two at once)")
     a = p.parse_args()
     if a.action == "run":
-        run(a.cases or list(CASES), a.out)
+        run(a.cases or list(CASES), a.out, a.threads)
     elif a.action == "wave":
-        wave(a.out)
+        wave(a.out, a.cases or None)
     else:
         table(a.out)
 

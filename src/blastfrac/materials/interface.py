@@ -59,6 +59,20 @@ def softening_slope(strength: float, fracture_energy: float | None, k: float) ->
     return strength**2 / (2.0 * g_eff)
 
 
+def band_slopes(strength: float, fracture_energy: np.ndarray, k: float) -> np.ndarray:
+    """softening_slope for an array of fracture energies [J/m²] (one per interface) at one strength [Pa] and
+    nominal stiffness k [Pa/m]; raises ValueError, naming the smallest, where one would snap back."""
+    g = np.asarray(fracture_energy, float)
+    g_eff = g - strength**2 / (2.0 * k)
+    if np.any(g_eff <= 0.0):
+        raise ValueError(
+            f"fracture energy {g.min():.3g} J/m² (the fracture band's share on the thinnest blocks) is below "
+            f"strength²/(2k) = {strength**2 / (2 * k):.3g} J/m²: the spring would snap back; raise the fracture "
+            "energy or the stiffness, or narrow rock.fracture_band_width"
+        )
+    return strength**2 / (2.0 * g_eff)
+
+
 @wp.func
 def spring_update_intact(
     fn: wp.float64, fs: wp.float64, t_str: wp.float64, c_str: wp.float64,

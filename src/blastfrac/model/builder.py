@@ -12,7 +12,7 @@ from ..geometry.mesh import TriMesh, generate_mesh
 from ..materials.elastic import lame
 from .compliance import elastic_report, spring_compliance_density
 from .heterogeneity import interface_factors, rms
-from ..materials.interface import softening_slope
+from ..materials.interface import band_slopes, softening_slope
 from ..scenario.schema import Scenario
 from .model import Model
 from .topology import build_topology
@@ -97,6 +97,19 @@ class ModelBuilder:
         c_ref = rms(c_q, L) if "cohesion" in self.factors and len(L) else rock.cohesion
         self.slope_t = softening_slope(t_ref, rock.tensile_fracture_energy, kn_min_nominal)
         self.slope_c = softening_slope(c_ref, rock.shear_fracture_energy, ks_min_nominal)
+        # fracture band (rock.fracture_band_width w_c): an interface whose blocks are thinner than w_c carries
+        # the share h̄_q/w_c of the fracture energies, so that the energy of fragmenting a volume is the same on
+        # any mesh finer than w_c (docs/scenario.md "Fracture band"); a per-interface softening rate
+        law, self.band_factor = None, None
+        if rock.fracture_band_width is not None:
+            hbar_q = (area[e1] + area[e2]) / L
+            self.band_factor = np.minimum(1.0, hbar_q / rock.fracture_band_width)
+            law = np.empty((len(L), 4))
+            law[:, 0] = math.tan(math.radians(rock.friction_angle))
+            law[:, 1] = math.tan(math.radians(rock.residual_friction))
+            for col, gf, s_ref, k_min in ((2, rock.tensile_fracture_energy, t_ref, kn_min_nominal),
+                                          (3, rock.shear_fracture_energy, c_ref, ks_min_nominal)):
+                law[:, col] = (band_slopes(s_ref, gf * self.band_factor, k_min) if gf is not None else 0.0)
         # pre-existing joints (geometry.joints, docs/joints.md): their interfaces take the joint's strengths,
         # friction and (optional) stiffness. The rock's compliance compensation, softening rates and nominal
         # stiffness above are those of the rock (a joint's own compliance is physical, not compensated).
@@ -104,7 +117,9 @@ class ModelBuilder:
         h["iface_joint"] = jq
         h["pair_joint"] = np.repeat(jq, 2)
         if np.any(jq >= 0):
-            self._joint_properties(h, jq, kn_a, ks_a, ac, t_q, c_q)
+            self._joint_properties(h, jq, kn_a, ks_a, ac, t_q, c_q, law)
+        elif law is not None:
+            h["pair_law"] = np.repeat(law, 2, axis=0)
         h["pair_t0"] = np.repeat(t_q, 2)
         h["pair_c0"] = np.repeat(c_q, 2)
         # the unit normal of each interface, e1 → e2, for the stable-step row sums
@@ -115,12 +130,14 @@ class ModelBuilder:
         self.host = h
         self.stable_dt = self._gershgorin_dt(h, X)
 
-    def _joint_properties(self, h: dict, jq: np.ndarray, kn_a, ks_a, ac, t_q, c_q) -> None:
-        """Give the joint interfaces their set's properties (in place on t_q, c_q and the stiffness arrays)."""
+    def _joint_properties(self, h: dict, jq: np.ndarray, kn_a, ks_a, ac, t_q, c_q, law=None) -> None:
+        """Give the joint interfaces their set's properties (in place on t_q, c_q and the stiffness arrays);
+        ``law`` [Q, 4]: the rock's per-interface law (a fracture band), else the rock's scalars."""
         rock = self.scenario.rock
-        law = np.empty((len(jq), 4))
-        law[:] = (math.tan(math.radians(rock.friction_angle)), math.tan(math.radians(rock.residual_friction)),
-                  self.slope_t, self.slope_c)
+        if law is None:
+            law = np.empty((len(jq), 4))
+            law[:] = (math.tan(math.radians(rock.friction_angle)), math.tan(math.radians(rock.residual_friction)),
+                      self.slope_t, self.slope_c)
         mode0 = np.zeros(len(jq), np.int32)
         for s, js in enumerate(self.scenario.geometry.joints):
             m = jq == s
@@ -232,8 +249,6 @@ class ModelBuilder:
         def arr(a, dtype):
             return wp.array(np.ascontiguousarray(a), dtype=dtype, device=d)
 
-        pair_slope = np.zeros((self.topology.pair_nodes.shape[0], 2))
-        pair_slope[:, 0], pair_slope[:, 1] = self.slope_t, self.slope_c
         m = Model(
             mesh=self.mesh, topology=self.topology, device=d,
             lam=self.lam, mu=self.mu, density=rock.density,

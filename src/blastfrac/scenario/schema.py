@@ -205,6 +205,14 @@ class RockConfig(_Strict):
     shear_fracture_energy: float | None = Field(
         None, gt=0, description="Mode II fracture energy G_fII [J/m²]; enables linear cohesion softening."
     )
+    fracture_band_width: float | None = Field(
+        None, gt=0, le=1.0, description="Width w_c of the fracture process band [m] (not in the paper), (0, 1]; None "
+        "(default): every interface carries the full G_fI, G_fII. Set: an interface whose two blocks have the mean "
+        "height h̄ = (A1 + A2)/L < w_c carries the share h̄/w_c of both fracture energies (min(1, h̄/w_c)), so that "
+        "fragmenting a region finer than w_c costs 3·G_f/w_c per unit area on any mesh, and a physical crack "
+        "resolved by w_c/h̄ parallel lattice cracks costs G_f. Needs a fracture energy. See docs/scenario.md, "
+        "'Fracture band'.",
+    )
     unbreakable: bool = Field(False, description="Springs never fail (elastic verification runs).")
     block_contact: bool = Field(
         True, description="Node-to-edge frictional contact between blocks whose springs have broken and separated "
@@ -250,6 +258,10 @@ class RockConfig(_Strict):
         ):
             if gf is not None and s == 0:
                 raise ValueError(f"{name}_fracture_energy given but the matching strength is 0")
+        if self.fracture_band_width is not None and self.tensile_fracture_energy is None \
+                and self.shear_fracture_energy is None:
+            raise ValueError("fracture_band_width scales the fracture energies, but neither "
+                             "tensile_fracture_energy nor shear_fracture_energy is given")
         return self
 
     @property
