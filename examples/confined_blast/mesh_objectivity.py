@@ -13,14 +13,15 @@ length per area in annuli, from each run's last ParaView frame. ``wave`` runs th
 unbreakable rock and monitors at 25–200 mm (with and without the shock viscosity, ~20 s and ~110 s each) and
 prints the peak radial compression and hoop tension.
 
-Cases: 'hom' = the shipped homogeneous rock; 'iid' = Weibull m = 5 on T and c (correlated), one draw per
+Cases: 'hom' = the example's homogeneous rock; 'iid' = Weibull m = 5 on T and c (correlated), one draw per
 interface whatever its length; 'wl' = the same with weakest-link size scaling, reference_length 5 mm; 'wl3' =
 'wl' with m = 3; 'cf' = Weibull m = 5 (T and c) spatially correlated over ℓ = 3 mm
 (rock.heterogeneity.correlation_length), identical on both meshes for one seed; 'gv2'/'gvb' = the halved mesh
 with G_fII (gv2) or both fracture energies (gvb) halved; 'fb12'/'fb25' = rock.fracture_band_width 1.2 / 2.5 mm;
 'farq_near1' / 'farq_near05' = the quarter mesh's far size (2.5 mm) with the shipped / halved wall size.
-'ship' = the shipped mesh, 'half' = mesh_size 5 mm and mesh_size_near 0.5 mm (the MPM cell is 0.5 mm on both),
-'quarter' = 2.5 mm and 0.25 mm (hom only; about 25 minutes on 2 cores).
+'ship' = the mesh the example shipped until stop 23 (1 mm at the wall, mesh_size 10 mm), 'half' = mesh_size 5 mm and
+mesh_size_near 0.5 mm (the MPM cell is 0.5 mm on both), 'quarter' = 2.5 mm and 0.25 mm (hom only; about 35 minutes
+on 2 cores). 'farq_near1' is the example's mesh since stop 23 (mesh_size 2.5 mm).
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ from pathlib import Path
 
 HERE = Path(__file__).parent
 SCENARIO = HERE / "scenario_P0.toml"
+#: the mesh the example shipped until stop 23 (10 mm beyond the refinement zone), which every 'ship' case uses
+SHIP = ["geometry.mesh_size=0.01"]
 HALF = ["geometry.mesh_size_near=0.0005", "geometry.mesh_size=0.005", "explosive.grid.cell_size=0.0005"]
 #: the halved mesh halved again (the convergence check of the halved mesh; the MPM cell stays 0.5 mm)
 QUARTER = ["geometry.mesh_size_near=0.00025", "geometry.mesh_size=0.0025", "explosive.grid.cell_size=0.0005"]
@@ -49,35 +52,35 @@ CF = IID + [f"rock.heterogeneity.correlation_length={ELL}"]
 
 #: name → overrides, in the order of the study (the most informative first)
 CASES: dict[str, list[str]] = {
-    "hom_ship": [],
+    "hom_ship": SHIP,
     "hom_half": HALF,
     "hom_quarter": QUARTER,
-    "wl_ship_s0": WL,
+    "wl_ship_s0": SHIP + WL,
     "wl_half_s0": WL + HALF,
-    "iid_ship_s0": IID,
+    "iid_ship_s0": SHIP + IID,
     "iid_half_s0": IID + HALF,
-    "wl_ship_s1": WL + ["simulation.seed=1"],
-    "wl_ship_s2": WL + ["simulation.seed=2"],
+    "wl_ship_s1": SHIP + WL + ["simulation.seed=1"],
+    "wl_ship_s2": SHIP + WL + ["simulation.seed=2"],
     "wl_half_s1": WL + HALF + ["simulation.seed=1"],
-    "iid_ship_s1": IID + ["simulation.seed=1"],
+    "iid_ship_s1": SHIP + IID + ["simulation.seed=1"],
     "iid_half_s1": IID + HALF + ["simulation.seed=1"],
-    "wl3_ship_s0": [x.replace(f"={M}", "=3.0") for x in WL],
+    "wl3_ship_s0": SHIP + [x.replace(f"={M}", "=3.0") for x in WL],
     "wl3_half_s0": [x.replace(f"={M}", "=3.0") for x in WL] + HALF,
     # the shipped energies halved on the halved mesh: what a fracture energy per unit volume would give
     "gv2_half": HALF + ["rock.shear_fracture_energy=250"],
     "gvb_half": HALF + ["rock.shear_fracture_energy=250", "rock.tensile_fracture_energy=25"],
     # the fracture band (rock.fracture_band_width): the share h̄/w_c of G_f on blocks thinner than w_c
-    "fb12_ship": ["rock.fracture_band_width=0.0012"],
+    "fb12_ship": SHIP + ["rock.fracture_band_width=0.0012"],
     "fb12_half": HALF + ["rock.fracture_band_width=0.0012"],
-    "fb25_ship": ["rock.fracture_band_width=0.0025"],
+    "fb25_ship": SHIP + ["rock.fracture_band_width=0.0025"],
     "fb25_half": HALF + ["rock.fracture_band_width=0.0025"],
     # a far mesh that carries the wave (2.5 mm everywhere beyond the refinement, as on the quarter mesh) with
     # the shipped (1 mm) or the halved (0.5 mm) wall mesh: the near-wall refinement alone
     "farq_near1": ["geometry.mesh_size=0.0025"],
     "farq_near05": ["geometry.mesh_size=0.0025", "geometry.mesh_size_near=0.0005"],
-    "cf_ship_s0": CF,
+    "cf_ship_s0": SHIP + CF,
     "cf_half_s0": CF + HALF,
-    "cf_ship_s1": CF + ["simulation.seed=1"],
+    "cf_ship_s1": SHIP + CF + ["simulation.seed=1"],
     "cf_half_s1": CF + HALF + ["simulation.seed=1"],
 }
 
@@ -266,7 +269,8 @@ def ring_table(out: Path) -> None:
 
 #: radii [mm] of the +x monitors of the wave check, and its cases (unbreakable rock; with/without shock viscosity)
 WAVE_R = (25, 50, 75, 100, 150, 200)
-WAVE = {"ship": [], "half": HALF[:2], "ship_novisc": ["rock.bulk_viscosity_linear=0", "rock.bulk_viscosity_quadratic=0"],
+WAVE = {"ship": SHIP, "half": HALF[:2], "farq": ["geometry.mesh_size=0.0025"],
+        "ship_novisc": SHIP + ["rock.bulk_viscosity_linear=0", "rock.bulk_viscosity_quadratic=0"],
         "half_novisc": HALF[:2] + ["rock.bulk_viscosity_linear=0", "rock.bulk_viscosity_quadratic=0"]}
 
 
