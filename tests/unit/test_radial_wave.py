@@ -15,10 +15,11 @@ import math
 import numpy as np
 import pytest
 
-from blastfrac.analysis.radial_wave import disc_quadrature, plane_strain_lame, radial_wave
+from blastfrac.analysis.radial_wave import disc_quadrature, radial_wave
+from blastfrac.materials.elastic import lame
 
 E, NU, RHO, RB = 50e9, 0.2, 2600.0, 0.005
-LAM, MU = plane_strain_lame(E, NU)
+LAM, MU = lame(E, NU)
 CP = math.sqrt((LAM + 2 * MU) / RHO)
 
 

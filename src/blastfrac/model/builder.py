@@ -52,11 +52,11 @@ class ModelBuilder:
         na, nb = s1, 3 * (s1 // 3) + (s1 % 3 + 1) % 3
         L = np.linalg.norm(X[nb] - X[na], axis=1)
         e1, e2 = topo.iface_elems[:, 0], topo.iface_elems[:, 1]
+        hbar = (area[e1] + area[e2]) / L              # mean of the two heights 2A/L [m]
         if rock.stiffness_mode == "per_area":
             kn_a = np.full(len(L), rock.kn)
             ks_a = np.full(len(L), rock.ks)
         else:
-            hbar = (area[e1] + area[e2]) / L          # mean of the two heights 2A/L
             kn_a = rock.spring_penalty * rock.plane_strain_modulus / hbar
             ks_a = kn_a.copy()
         # heterogeneous rock: one unit-mean Weibull factor per interface and property, shared by the
@@ -102,8 +102,7 @@ class ModelBuilder:
         # any mesh finer than w_c (docs/scenario.md "Fracture band"); a per-interface softening rate
         law, self.band_factor = None, None
         if rock.fracture_band_width is not None:
-            hbar_q = (area[e1] + area[e2]) / L
-            self.band_factor = np.minimum(1.0, hbar_q / rock.fracture_band_width)
+            self.band_factor = np.minimum(1.0, hbar / rock.fracture_band_width)
             law = np.empty((len(L), 4))
             law[:, 0] = math.tan(math.radians(rock.friction_angle))
             law[:, 1] = math.tan(math.radians(rock.residual_friction))
