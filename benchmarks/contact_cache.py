@@ -36,7 +36,7 @@ def _save(sim) -> dict:
     st, c = sim.state, sim.cdem.contact
     snap = {k: getattr(st, k).numpy().copy() for k in STATE_ARRAYS}
     snap.update({"c_" + k: getattr(c, k).numpy().copy() for k in CONTACT_ARRAYS})
-    snap.update(time=sim.time, dt_prev=sim.cdem.dt_prev, step=c._step, active=c.active)
+    snap.update(time=sim.time, dt_prev=sim.cdem.dt_prev, clock=c._clock.numpy().copy(), active=c.active)
     return snap
 
 
@@ -47,25 +47,33 @@ def _restore(sim, snap: dict) -> None:
     for k in CONTACT_ARRAYS:
         getattr(c, k).assign(snap["c_" + k])
     sim.time, sim.cdem.dt_prev = snap["time"], snap["dt_prev"]
-    c._step, c.active = snap["step"], snap["active"]
+    c._clock.assign(snap["clock"])
+    c.active = snap["active"]
     c._built = False                             # the hash is rebuilt at the first step
 
 
-def _time_steps(sim, steps: int, warm: int = 3) -> tuple[float, float]:
+def _time_steps(sim, steps: int, warm: int = 3, graph: bool = False) -> tuple[float, float]:
     """(wall, CPU) ms per rock step (forces + integrate), after warm untimed steps. On a CPU device the kernels
-    run in this thread, so the process CPU time is the cost of the step itself, little disturbed by other load."""
+    run in this thread, so the process CPU time is the cost of the step itself, little disturbed by other load.
+    With ``graph`` the timed steps are replayed from a captured graph (``CDEMSolver.step_captured``; the graph is
+    captured in the last warm step)."""
     import warp as wp
 
-    st, dt = sim.state, sim.dt
-    for _ in range(warm):
-        sim.cdem.forces(st, dt, sim.time)
-        sim.cdem.integrate(st, dt, sim.alpha)
+    st, dt, cdem = sim.state, sim.dt, sim.cdem
+    for k in range(warm):
+        if not (graph and k == warm - 1 and cdem.step_captured(st, dt, sim.time, sim.alpha)):
+            cdem.forces(st, dt, sim.time)
+            cdem.integrate(st, dt, sim.alpha)
         sim.time += dt
     wp.synchronize()
     t0, c0 = time.perf_counter(), time.process_time()
     for _ in range(steps):
-        sim.cdem.forces(st, dt, sim.time)
-        sim.cdem.integrate(st, dt, sim.alpha)
+        if graph:
+            if not cdem.step_captured(st, dt, sim.time, sim.alpha):
+                raise RuntimeError("the rock step could not be captured")
+        else:
+            cdem.forces(st, dt, sim.time)
+            cdem.integrate(st, dt, sim.alpha)
         sim.time += dt
     wp.synchronize()
     return (time.perf_counter() - t0) / steps * 1e3, (time.process_time() - c0) / steps * 1e3
@@ -142,28 +150,31 @@ def run(scenario: str = "examples/circular_rock/demo.toml", steps: int = 200, ro
         intact.cdem.contact.active = True
         intact.dt = cracked.dt                      # the same Δt on both sides
         snap_i = _save(intact)
-    # (name, simulation, its BlockContact, snapshot, fan_cache, contact active)
-    cfgs = [("intact", intact, intact.cdem.contact, snap_i, True, True),
-            ("intact_no_contact", intact, intact.cdem.contact, snap_i, True, False),
-            ("cracked_uncached", cracked, cracked.cdem.contact, snap_c, False, True),
-            ("cracked_cached", cracked, cracked.cdem.contact, snap_c, True, True)]
+    # (name, simulation, its BlockContact, snapshot, fan_cache, contact active, captured graph)
+    cfgs = [("intact", intact, intact.cdem.contact, snap_i, True, True, False),
+            ("intact_no_contact", intact, intact.cdem.contact, snap_i, True, False, False),
+            ("cracked_uncached", cracked, cracked.cdem.contact, snap_c, False, True, False),
+            ("cracked_cached", cracked, cracked.cdem.contact, snap_c, True, True, False),
+            ("intact_graph", intact, intact.cdem.contact, snap_i, True, True, True),
+            ("cracked_graph", cracked, cracked.cdem.contact, snap_c, True, True, True)]
     if baseline:
         base = load_baseline(baseline)
-        cfgs += [("baseline_intact", intact, base(intact.model), snap_i, True, True),
-                 ("baseline_cracked", cracked, base(cracked.model), snap_c, True, True)]
+        cfgs += [("baseline_intact", intact, base(intact.model), snap_i, True, True, False),
+                 ("baseline_cracked", cracked, base(cracked.model), snap_c, True, True, False)]
     wall = {c[0]: np.inf for c in cfgs}
     cpu = dict(wall)
     for _ in range(rounds):
-        for key, sim, contact, snap, cached, active in cfgs:
+        for key, sim, contact, snap, cached, active, graph in cfgs:
             sim.cdem.contact = contact
             _restore(sim, snap)
             contact.active = active
             contact.fan_cache = cached
-            w, u = _time_steps(sim, steps)
+            w, u = _time_steps(sim, steps, graph=graph)
             wall[key], cpu[key] = min(wall[key], w), min(cpu[key], u)
     for sim, contact in ((intact, cfgs[0][2]), (cracked, cfgs[2][2])):
         sim.cdem.contact, contact.fan_cache = contact, True
-    ratios = {"cached": ("cracked_cached", "intact"), "uncached": ("cracked_uncached", "intact")}
+    ratios = {"cached": ("cracked_cached", "intact"), "uncached": ("cracked_uncached", "intact"),
+              "graph": ("cracked_graph", "intact_graph")}
     if baseline:
         ratios["baseline"] = ("baseline_cracked", "baseline_intact")
     return {"scenario": scenario, "device": device, "demo_steps": demo_steps, "demo_wall_s": demo_wall,
@@ -194,7 +205,8 @@ def main(argv=None) -> None:
     print(f"rock step (forces + integrate), least of {r['rounds']} x {r['steps']} steps [ms/step], wall and CPU:")
     rows = [("intact, contact on", "intact", None), ("intact, contact off", "intact_no_contact", None),
             ("cracked, fan cache off", "cracked_uncached", "uncached"),
-            ("cracked, fan cache on", "cracked_cached", "cached")]
+            ("cracked, fan cache on", "cracked_cached", "cached"),
+            ("intact, captured graph", "intact_graph", None), ("cracked, captured graph", "cracked_graph", "graph")]
     if r["baseline"]:
         rows += [(f"intact, {r['baseline']}", "baseline_intact", None),
                  (f"cracked, {r['baseline']}", "baseline_cracked", "baseline")]

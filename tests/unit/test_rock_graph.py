@@ -4,10 +4,8 @@ A rock-only run with a time-dependent borehole pulse that breaks springs, steppe
 once with every step through the launches (``Simulation.use_graph = False``), once with the steps replayed from
 a captured graph wherever one can stand for them (on a GPU the same path is a CUDA graph). Every state array, the
 break times (read from the device clock) and the energy books must agree to the last bit, and the graph must
-have carried every step but the first (which has no previous step). Block contact keeps the graph out (its pass
-reads counts back every step), so the fracture case runs without it (``rock.block_contact = false``), and a
-case with it checks that the run falls back to the launches. The in-situ relaxation (a rock-only stage of its
-own) likewise.
+have carried every step but the first (which has no previous step), with and without block contact (whose
+schedule runs on the device inside the graph). The in-situ relaxation (a rock-only stage of its own) likewise.
 """
 
 import numpy as np
@@ -63,13 +61,33 @@ def test_captured_rock_steps_are_bit_identical_through_fracture(tmp_path):
     assert 0.0 < tb.min() < tb.max() < cap.time            # at the times of the device clock
 
 
-def test_block_contact_keeps_the_launches(tmp_path):
+def test_captured_steps_with_block_contact_are_bit_identical(tmp_path):
+    """Block contact inside the graph: its schedule (step count, hash check and rebuild) on the device, its branches
+    through wp.capture_if, its launches over every item. Through fracture, contact, hash rebuilds and fan-cache
+    refreshes, the replay must do what the launches do, to the last bit."""
     ref, cap = _pair(tmp_path, contact=True)
-    for _ in range(200):
+    for sim in (ref, cap):                  # a thin skin, so that the hash is rebuilt as the wall moves (h_min/4:
+        c = sim.cdem.contact                # once in these 30 µs)
+        c.rebuild_skin = 0.01 * c.h_min
+    steps, contacts = 1500, 0
+    for k in range(steps):
         ref.step()
         cap.step()
+        contacts = max(contacts, cap.cdem.contact.active_count()) if k % 50 == 49 else contacts
+        if k % 100 == 99:
+            _same(ref, cap)
     _same(ref, cap)
-    assert cap.cdem.contact.active and cap.cdem.graph_steps == 0
+    for name in ("contact_slot", "contact_fs", "contact_d0", "contact_p", "contact_kc", "loss_acc", "elem_near",
+                 "query_after", "fan_count", "node_flag"):
+        assert np.array_equal(getattr(ref.cdem.contact, name).numpy(), getattr(cap.cdem.contact, name).numpy()), name
+    c = cap.cdem.contact
+    broken = int(np.count_nonzero(cap.state.pair_mode.numpy()))
+    print(f"graph steps {cap.cdem.graph_steps} of {steps}; {broken} springs broken; hash rebuilds {c.rebuilds} "
+          f"(launches: {ref.cdem.contact.rebuilds}); most contacts at once {contacts}; slip loss "
+          f"{c.losses()['slip']:.3e} J/m")
+    assert ref.cdem.graph_steps == 0 and cap.cdem.graph_steps == steps - 1
+    assert c.rebuilds == ref.cdem.contact.rebuilds >= 5      # rebuilt inside the graph (the first build is not)
+    assert broken > 100 and contacts >= 10                   # fracture and contact happened under the graph
 
 
 def test_captured_insitu_relaxation_is_bit_identical(tmp_path):

@@ -135,8 +135,10 @@ from .contact_geometry import FAN_CACHE, LOSS_PENALTY, LOSS_SLIP
 from .contact_hash import (
     compute_edge_samples,
     compute_sample_cells,
+    contact_tick,
     gather_sample_cells,
     largest_displacement,
+    rebuild_decision,
 )
 from .contact_kernels import eval_block_contact
 
@@ -227,11 +229,15 @@ class BlockContact:
         self.rebuild_interval = 10
         self.rebuild_check = 5
         self.rebuild_skin = 0.25 * self.h_min                          # [m]
-        self._since_build = self.rebuild_check
         self._built = False
         self._x_build = wp.zeros(n, dtype=wp.vec2d, device=d)         # node positions when the hash was built
         self._moved = wp.zeros(1, dtype=wp.float64, device=d)          # largest squared displacement since [m²]
-        self.rebuilds = 0
+        # the schedule on the device (contact_tick): step count and steps since the build (checked at the first
+        # call), the two branch flags of wp.capture_if, the number of builds
+        self._clock = wp.array([0, self.rebuild_check], dtype=wp.int32, device=d)
+        self._check_due = wp.zeros(1, dtype=wp.int32, device=d)
+        self._rebuild_due = wp.zeros(1, dtype=wp.int32, device=d)
+        self._rebuilds = wp.zeros(1, dtype=wp.int32, device=d)
         # Blocks an open face has come within h_min of stay "woken" for near_window steps: their held-broken
         # nodes then search the hash too, so a node of theirs cannot enter the open block unseen (module doc).
         self.near_window = 2 * self.rebuild_interval
@@ -274,8 +280,7 @@ class BlockContact:
         self._counts_all = wp.array([0, n], dtype=wp.int32, device=d)
         self._cand_list = wp.zeros(n, dtype=wp.int32, device=d)       # list_candidates
         self._cand_count = wp.zeros(1, dtype=wp.int32, device=d)
-        self._n_cand = 0
-        self._step = 0
+        self._cpu = wp.get_device(d).is_cpu
         self._launch = Launcher()                 # recorded launches (packing costs more than a small mesh's pass)
         self._structs()
 
@@ -301,11 +306,14 @@ class BlockContact:
         self.s_prm = ContactParams()
         self._prm_values = None
 
+    def _params_values(self) -> tuple:
+        return (self.kn_area, self.mu_f, self.radius, self.h_min, int(self.near_window), int(self.rebuild_interval),
+                int(bool(self.held_faces)))
+
     def _params(self) -> ContactParams:
         """The scheme's scalars as they are now (tests and benchmarks change held_faces and near_window); the
         struct's fields are set only when one has changed."""
-        values = (self.kn_area, self.mu_f, self.radius, self.h_min, int(self.near_window),
-                  int(self.rebuild_interval), int(bool(self.held_faces)))
+        values = self._params_values()
         if values != self._prm_values:
             prm = self.s_prm
             prm.kn_area, prm.mu_f, prm.search_radius = self.kn_area, self.mu_f, self.radius
@@ -315,82 +323,109 @@ class BlockContact:
         return self.s_prm
 
     def apply(self, state, dt: float) -> None:
-        """Add the contact forces of the current configuration to state.f; dt [s] drives the friction."""
+        """Add the contact forces of the current configuration to state.f; dt [s] drives the friction.
+
+        Nothing is read back to the host, so the pass can be captured in a graph (CDEMSolver.step_captured): the
+        schedule (step count, hash check and rebuild) lives on the device (``contact_tick``) and its branches run
+        through ``wp.capture_if`` (which reads its flag on the host when not capturing: free on a CPU, a sync on a
+        GPU); the launches over this step's lists run one thread per item on a GPU and one thread over the whole
+        list on a CPU (``_lanes``), whatever its length."""
         if not self.active or self.kn_area == 0.0:
             return
         m = self.model
         use_cache = int(bool(self.fan_cache))
         # (a switch of fan_cache builds the other hash at once: only tests and benchmarks switch)
-        rebuild = not self._built or use_cache != self._grid_kind
-        if not rebuild and self._since_build >= self.rebuild_check:
-            self._moved.zero_()
-            wp.launch(largest_displacement, dim=m.node_count, inputs=[state.x, self._x_build], outputs=[self._moved],
-                      device=m.device)
-            rebuild = float(self._moved.numpy()[0]) > self.rebuild_skin ** 2
-            self._since_build = 0
-        if rebuild:
-            ns = self.points.shape[0]
-            if use_cache:
-                wp.launch(compute_sample_cells, dim=ns,
-                          inputs=[state.x, self.sample_slot, self.sample_frac, self.slot_iface, state.pair_mode,
-                                  self.cell_inv, self.cell_dim],
-                          outputs=[self.sample_xy, self.sample_code, self._keys, self._values], device=m.device)
-                wp.utils.radix_sort_pairs(self._keys, self._values, ns, end_bit=self._key_bits)
-                self.cell_starts.zero_()
-                self.cell_ends.zero_()
-                wp.launch(gather_sample_cells, dim=ns,
-                          inputs=[self._keys, self._values, ns, self.sample_xy, self.sample_code],
-                          outputs=[self.cell_starts, self.cell_ends, self.sorted_xy, self.sorted_code,
-                                   self.sample_pos], device=m.device)
-            else:
-                wp.launch(compute_edge_samples, dim=ns, inputs=[state.x, self.sample_slot, self.sample_frac],
-                          outputs=[self.points], device=m.device)
-                self.grid.build(self.points, self.radius)
-            wp.copy(self._x_build, state.x)
-            self._grid_kind = use_cache
-            self._built = True
-            self._since_build = 0
-            self.rebuilds += 1
-        self._since_build += 1
-        self._step += 1
-        step = self._step
-        cpu = wp.get_device(m.device).is_cpu
+        force = int(not self._built or use_cache != self._grid_kind)
+        self._launch(contact_tick, 1, [self._clock, self._check_due, self._rebuild_due, self._rebuilds, force,
+                                       int(self.rebuild_check)])
+        self._grid_kind = use_cache
+        self._built = True
+        wp.capture_if(self._check_due, on_true=self._check_moved, state=state)
+        wp.capture_if(self._rebuild_due, on_true=self._rebuild, state=state)
         self._counts.zero_()
         if use_cache:
             # caches of the vertices where a spring changed state since the last call (of every vertex at first)
-            refresh_all = int(not self._cache_fresh)
             if m.spring_count:
                 self._launch(mark_pair_changes, m.spring_count,
-                             [state.pair_mode, state.pair_dropped, self.pair_vertex, step, self.seen_mode,
+                             [state.pair_mode, state.pair_dropped, self.pair_vertex, self._clock, self.seen_mode,
                               self.seen_dropped, self.vertex_stamp, self._counts, self._dirty_vertices,
                               self.iface_slots, self.slot_samples, self.sample_pos, self.sorted_code])
-            # on a CPU the launches run over the listed items only; a GPU thread past a list's end leaves at once
-            dim = int(self._counts.numpy()[0]) if cpu and not refresh_all else self.vertex_count
-            if dim:
-                self._launch(refresh_fan_cache, dim,
-                             [refresh_all, self._counts, self._dirty_vertices, self.s_mesh, state.pair_mode,
-                              state.pair_dropped, self.s_cache])
-                self._cand_count.zero_()
-                self._launch(list_candidates, m.node_count, [self.node_flag, self._cand_count, self._cand_list])
-                self._n_cand = int(self._cand_count.numpy()[0]) if cpu else m.node_count
+            if not self._cache_fresh:
+                self._refresh(state, 1)
+            else:
+                wp.capture_if(self._counts, on_true=self._refresh, state=state, refresh_all=0)
         self._cache_fresh = bool(use_cache)
         prm = self._params()
-        node_list, counts, dim = self._all_nodes, self._counts_all, m.node_count
-        if use_cache and self._n_cand == 0:
-            return                                    # no node has an exposed edge
+        node_list, counts, n = self._all_nodes, self._counts_all, m.node_count
         if use_cache:
-            self._launch(select_contact_nodes, self._n_cand,
-                         [self._cand_list, self._cand_count, state.x, prm, step, self.s_cache, self.contact_slot,
-                          self._counts, self._node_list])
+            dim, stride = self._lanes(m.node_count)
+            self._launch(select_contact_nodes, dim,
+                         [self._cand_list, self._cand_count, stride, state.x, prm, self._clock, self.s_cache,
+                          self.contact_slot, self._counts, self._node_list])
             node_list, counts = self._node_list, self._counts
-            if cpu:
-                dim = int(self._counts.numpy()[1])
-        if dim == 0:
-            return
+        dim, stride = self._lanes(n)
         self._launch(eval_block_contact, dim,
-                     [node_list, counts, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist, prm,
-                      state.pair_mode, state.pair_dropped, state.x, state.v, step, float(dt), state.f,
+                     [node_list, counts, stride, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist, prm,
+                      state.pair_mode, state.pair_dropped, state.x, state.v, self._clock, float(dt), state.f,
                       state.energy_acc])
+
+    def _lanes(self, n: int) -> tuple[int, int]:
+        """(threads, stride) of a launch over a list of at most n items whose length is on the device: one thread
+        per item on a GPU; on a CPU one thread that runs the list in order (each CPU thread copies the kernel's
+        structs, ~100 ns, so n threads that mostly leave at once cost more than the pass)."""
+        return (1, 1) if self._cpu else (n, n)
+
+    def capturable(self) -> bool:
+        """True when ``apply`` can be captured in a graph: the fan cache on (wp.HashGrid's build is not captured),
+        its caches and the hash built (the first call builds them on the host)."""
+        return bool(self.fan_cache) and self._cache_fresh and self._built and self._grid_kind == 1
+
+    def graph_key(self) -> tuple:
+        """What a captured contact pass holds fixed: a graph is captured again when it changes."""
+        return (self.active, bool(self.fan_cache), self._params_values())
+
+    # ------------------------------------------------------------------ the pass's branches (wp.capture_if)
+    def _check_moved(self, state) -> None:
+        """The displacement check: rebuild_due when a node has moved more than rebuild_skin since the build."""
+        self._moved.zero_()
+        self._launch(largest_displacement, self.model.node_count, [state.x, self._x_build, self._moved])
+        self._launch(rebuild_decision, 1, [self._moved, self.rebuild_skin ** 2, self._rebuild_due, self._rebuilds])
+
+    def _rebuild(self, state) -> None:
+        """The hash of the edges' sample points at the current positions (the cell grid, or wp.HashGrid without
+        the fan cache)."""
+        m = self.model
+        ns = self.points.shape[0]
+        if self.fan_cache:
+            self._launch(compute_sample_cells, ns,
+                         [state.x, self.sample_slot, self.sample_frac, self.slot_iface, state.pair_mode,
+                          self.cell_inv, self.cell_dim, self.sample_xy, self.sample_code, self._keys, self._values])
+            wp.utils.radix_sort_pairs(self._keys, self._values, ns, end_bit=self._key_bits)
+            self.cell_starts.zero_()
+            self.cell_ends.zero_()
+            self._launch(gather_sample_cells, ns,
+                         [self._keys, self._values, ns, self.sample_xy, self.sample_code, self.cell_starts,
+                          self.cell_ends, self.sorted_xy, self.sorted_code, self.sample_pos])
+        else:
+            wp.launch(compute_edge_samples, dim=ns, inputs=[state.x, self.sample_slot, self.sample_frac],
+                      outputs=[self.points], device=m.device)
+            self.grid.build(self.points, self.radius)
+        wp.copy(self._x_build, state.x)
+
+    def _refresh(self, state, refresh_all: int) -> None:
+        """Rebuild the fan caches of the listed vertices (of all with refresh_all), then the candidate list."""
+        m = self.model
+        dim, stride = self._lanes(self.vertex_count)
+        self._launch(refresh_fan_cache, dim,
+                     [refresh_all, self._counts, self._dirty_vertices, self.s_mesh, state.pair_mode,
+                      state.pair_dropped, self.s_cache, self.vertex_count, stride])
+        self._cand_count.zero_()
+        self._launch(list_candidates, m.node_count, [self.node_flag, self._cand_count, self._cand_list])
+
+    @property
+    def rebuilds(self) -> int:
+        """How many times the hash has been built."""
+        return int(self._rebuilds.numpy()[0])
 
     # ------------------------------------------------------------------ diagnostics (host side, not per step)
     def stored_energy(self) -> float:

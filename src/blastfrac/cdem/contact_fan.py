@@ -217,7 +217,7 @@ def mark_pair_changes(
     pair_mode: wp.array(dtype=wp.int32),
     pair_dropped: wp.array(dtype=wp.int32),
     pair_vertex: wp.array(dtype=wp.int32),
-    step: wp.int32,
+    clock: wp.array(dtype=wp.int32),
     seen_mode: wp.array(dtype=wp.int32),
     seen_dropped: wp.array(dtype=wp.int32),
     vertex_stamp: wp.array(dtype=wp.int32),
@@ -232,6 +232,7 @@ def mark_pair_changes(
     last call makes stale: both ends of p's interface (the exposure of its edges counts at both vertices, the
     exclusion chains at p's own); and the sorted_code sign of the hash points on the interface's two edges."""
     p = wp.tid()
+    step = clock[0]
     mode = pair_mode[p]
     dropped = pair_dropped[p]
     if mode != seen_mode[p] or dropped != seen_dropped[p]:
@@ -286,25 +287,10 @@ def node_woken(e: wp.int32, elem_near: wp.array(dtype=wp.int32), step: wp.int32,
     return elem_near[e] >= step - near_window and elem_near[e] < step
 
 
-@wp.kernel
-def refresh_fan_cache(
-    refresh_all: wp.int32,
-    counts: wp.array(dtype=wp.int32),
-    dirty_vertices: wp.array(dtype=wp.int32),
-    mesh: ContactMesh,
-    pair_mode: wp.array(dtype=wp.int32),
-    pair_dropped: wp.array(dtype=wp.int32),
-    cache: ContactCache,
-):
-    """Rebuild the caches (node_faces and node_flag, fan_exclusions mask, fan_cache_build list) of every node at
-    a listed vertex (every vertex with refresh_all): each thread writes only its own vertex's nodes, from the
-    spring states, so the order of the threads does not matter."""
-    i = wp.tid()
-    vtx = i
-    if refresh_all == 0:
-        if i >= counts[0]:
-            return
-        vtx = dirty_vertices[i]
+@wp.func
+def refresh_vertex(vtx: wp.int32, mesh: ContactMesh, pair_mode: wp.array(dtype=wp.int32),
+                   pair_dropped: wp.array(dtype=wp.int32), cache: ContactCache):
+    """The caches of the nodes at vertex vtx (refresh_fan_cache)."""
     for j in range(mesh.vertex_start[vtx], mesh.vertex_start[vtx + 1]):
         n = mesh.vertex_nodes[j]
         nf = node_faces(n, mesh.slot_iface, mesh.slot_l0, pair_mode, pair_dropped)
@@ -321,6 +307,34 @@ def refresh_fan_cache(
 
 
 @wp.kernel
+def refresh_fan_cache(
+    refresh_all: wp.int32,
+    counts: wp.array(dtype=wp.int32),
+    dirty_vertices: wp.array(dtype=wp.int32),
+    mesh: ContactMesh,
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+    cache: ContactCache,
+    vertex_count: wp.int32,
+    stride: wp.int32,
+):
+    """Rebuild the caches (node_faces and node_flag, fan_exclusions mask, fan_cache_build list) of every node at
+    a listed vertex (every vertex with refresh_all): each thread writes only its own vertex's nodes, from the
+    spring states, so the order of the threads does not matter. Thread i takes items i, i + stride, ...
+    (eval_block_contact)."""
+    i = wp.tid()
+    end = vertex_count
+    if refresh_all == 0:
+        end = counts[0]
+    while i < end:
+        vtx = i
+        if refresh_all == 0:
+            vtx = dirty_vertices[i]
+        refresh_vertex(vtx, mesh, pair_mode, pair_dropped, cache)
+        i += stride
+
+
+@wp.kernel
 def list_candidates(node_flag: wp.array(dtype=wp.int32), cand_count: wp.array(dtype=wp.int32),
                     cand_list: wp.array(dtype=wp.int32)):
     """The nodes with an exposed edge at them (node_flag ≠ 0), in node order on a CPU: select_contact_nodes runs
@@ -330,10 +344,9 @@ def list_candidates(node_flag: wp.array(dtype=wp.int32), cand_count: wp.array(dt
         cand_list[wp.atomic_add(cand_count, 0, 1)] = n
 
 
-@wp.kernel
-def select_contact_nodes(
-    cand_list: wp.array(dtype=wp.int32),
-    cand_count: wp.array(dtype=wp.int32),
+@wp.func
+def select_node(
+    n: wp.int32,
     x: wp.array(dtype=wp.vec2d),
     prm: ContactParams,
     step: wp.int32,
@@ -342,14 +355,7 @@ def select_contact_nodes(
     counts: wp.array(dtype=wp.int32),
     node_list: wp.array(dtype=wp.int32),
 ):
-    """List (counts[1] of them, in node order on a CPU) the nodes of cand_list eval_block_contact has anything
-    to do for; it would leave the others without a write (from the caches: node_flag, fan candidates). A held node without
-    contact is listed only if one of its fan candidates passes the corner sign test (held_search makes the same
-    test first and finds nothing otherwise) and one of that corner's exposed edges passes edge_may_take."""
-    i = wp.tid()
-    if i >= cand_count[0]:
-        return
-    n = cand_list[i]
+    """List node n (at counts[1]) if eval_block_contact has anything to do for it (select_contact_nodes)."""
     flag = cache.node_flag[n]
     if flag == 0:
         return
@@ -386,3 +392,28 @@ def select_contact_nodes(
     elif is_open and not woken and step < cache.query_after[n] and contact_slot[n] < 0 and cache.fan_count[n] == 0:
         return
     node_list[wp.atomic_add(counts, 1, 1)] = n
+
+
+@wp.kernel
+def select_contact_nodes(
+    cand_list: wp.array(dtype=wp.int32),
+    cand_count: wp.array(dtype=wp.int32),
+    stride: wp.int32,
+    x: wp.array(dtype=wp.vec2d),
+    prm: ContactParams,
+    clock: wp.array(dtype=wp.int32),
+    cache: ContactCache,
+    contact_slot: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    node_list: wp.array(dtype=wp.int32),
+):
+    """List (counts[1] of them, in node order on a CPU) the nodes of cand_list eval_block_contact has anything
+    to do for; it would leave the others without a write (from the caches: node_flag, fan candidates). A held node without
+    contact is listed only if one of its fan candidates passes the corner sign test (held_search makes the same
+    test first and finds nothing otherwise) and one of that corner's exposed edges passes edge_may_take. Thread
+    i takes items i, i + stride, ... (eval_block_contact)."""
+    i = wp.tid()
+    step = clock[0]
+    while i < cand_count[0]:
+        select_node(cand_list[i], x, prm, step, cache, contact_slot, counts, node_list)
+        i += stride

@@ -44,6 +44,40 @@ def largest_displacement(x: wp.array(dtype=wp.vec2d), x_build: wp.array(dtype=wp
     wp.atomic_max(moved, 0, wp.dot(d, d))
 
 
+@wp.kernel
+def contact_tick(clock: wp.array(dtype=wp.int32), check_due: wp.array(dtype=wp.int32),
+                 rebuild_due: wp.array(dtype=wp.int32), rebuilds: wp.array(dtype=wp.int32), force_rebuild: wp.int32,
+                 rebuild_check: wp.int32):
+    """The contact pass's schedule, on the device (one thread, before the pass): clock[0] the step count, clock[1]
+    the steps since the hash was built. The displacement check is due (check_due[0] = 1) every rebuild_check steps,
+    a rebuild (rebuild_due[0] = 1, counted in rebuilds[0]) when forced (first build, another hash kind), otherwise
+    rebuild_decision sets it.
+    These flags drive ``wp.capture_if``, so the pass reads nothing back and can be captured in a graph."""
+    check = wp.int32(0)
+    rebuild = wp.int32(0)
+    if force_rebuild != 0:
+        rebuild = 1
+        rebuilds[0] = rebuilds[0] + 1
+        clock[1] = 0
+    elif clock[1] >= rebuild_check:
+        check = 1
+        clock[1] = 0
+    check_due[0] = check
+    rebuild_due[0] = rebuild
+    clock[1] = clock[1] + 1
+    clock[0] = clock[0] + 1
+
+
+@wp.kernel
+def rebuild_decision(moved: wp.array(dtype=wp.float64), skin2: wp.float64, rebuild_due: wp.array(dtype=wp.int32),
+                     rebuilds: wp.array(dtype=wp.int32)):
+    """rebuild_due[0] = 1 when a node has moved more than the skin since the build (moved[0] > skin² [m²]), and
+    count the rebuild (one thread)."""
+    if moved[0] > skin2:
+        rebuild_due[0] = 1
+        rebuilds[0] = rebuilds[0] + 1
+
+
 @wp.func
 def cell_coord(v: wp.float64):
     """Cell coordinate of a scaled position, as wp.HashGrid computes it (floor, clamped to the int range)."""

@@ -157,10 +157,9 @@ def contact_force(
 
 
 
-@wp.kernel
-def eval_block_contact(
-    node_list: wp.array(dtype=wp.int32),
-    counts: wp.array(dtype=wp.int32),
+@wp.func
+def node_contact(
+    n: wp.int32,
     use_cache: wp.int32,
     mesh: ContactMesh,
     hsh: ContactHash,
@@ -176,13 +175,7 @@ def eval_block_contact(
     f: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
-    """Contact of each listed node (select_contact_nodes). The tests that listed it are made again here, in
-    list order, so that the result is that of one pass over every node in node order (a node's woken flag can
-    turn off in the pass)."""
-    i = wp.tid()
-    if i >= counts[1]:
-        return
-    n = node_list[i]
+    """The contact of node n at this step (its search, then contact_force)."""
     zero = wp.float64(0.0)
     nf = wp.vec2d()
     if use_cache != 0:
@@ -218,3 +211,36 @@ def eval_block_contact(
         if st[0] < zero and hist.slot[n] < 0:
             return
     contact_force(n, nf[0], st, mesh, prm, x, v, dt, hist, f, energy_acc)
+
+
+@wp.kernel
+def eval_block_contact(
+    node_list: wp.array(dtype=wp.int32),
+    counts: wp.array(dtype=wp.int32),
+    stride: wp.int32,
+    use_cache: wp.int32,
+    mesh: ContactMesh,
+    hsh: ContactHash,
+    cache: ContactCache,
+    hist: ContactHistory,
+    prm: ContactParams,
+    pair_mode: wp.array(dtype=wp.int32),
+    pair_dropped: wp.array(dtype=wp.int32),
+    x: wp.array(dtype=wp.vec2d),
+    v: wp.array(dtype=wp.vec2d),
+    clock: wp.array(dtype=wp.int32),
+    dt: wp.float64,
+    f: wp.array(dtype=wp.vec2d),
+    energy_acc: wp.array(dtype=wp.float64),
+):
+    """Contact of each listed node (select_contact_nodes, counts[1] of them). The tests that listed it are made
+    again here, in list order, so that the result is that of one pass over every node in node order (a node's
+    woken flag can turn off in the pass). Thread i takes items i, i + stride, ...: one thread on a CPU (the list
+    in order, whatever its length, and no per-thread copy of the structs for the items past its end), one item
+    per thread on a GPU."""
+    i = wp.tid()
+    step = clock[0]
+    while i < counts[1]:
+        node_contact(node_list[i], use_cache, mesh, hsh, cache, hist, prm, pair_mode, pair_dropped, x, v, step, dt,
+                     f, energy_acc)
+        i += stride

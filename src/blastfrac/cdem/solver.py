@@ -117,16 +117,17 @@ class CDEMSolver:
         (``wp.capture_begin``: a CUDA graph on a GPU, Warp's C++ replay of the recorded operations on a CPU); the
         clock (a device array the springs read) and the pulses are set before each replay. The same kernels on
         the same arrays as ``forces`` + ``integrate``, so the same results to the bit
-        (tests/unit/test_rock_graph.py). Returns False, having done nothing, where a graph cannot stand for the
-        step: block contact active (its pass sizes its launches from counts read back every step), the step not
-        yet repeating (dt_prev ≠ dt), or pulses on a GPU (their host buffer is rewritten before an asynchronous
-        replay has read it). The graph is captured again whenever a scalar it holds (dt, alpha, breakable), the
-        state or ``after`` changes."""
+        (tests/unit/test_rock_graph.py). Block contact reads nothing back (``BlockContact.apply``). Returns False, having done nothing,
+        where a graph cannot stand for the step: block contact not yet built (its first pass builds its caches on
+        the host) or without its fan cache, the step not yet repeating (dt_prev ≠ dt), or pulses on a GPU (their
+        host buffer is rewritten before an asynchronous replay has read it). The graph is captured again whenever
+        a scalar it holds (dt, alpha, breakable, the contact's settings), the state or ``after`` changes."""
         m = self.model
-        if (self.contact is not None and self.contact.active) or self.dt_prev != dt or \
+        c = self.contact
+        if (c is not None and c.active and not c.capturable()) or self.dt_prev != dt or \
                 (m.pulses and m.device != "cpu"):
             return False
-        key = (id(state), dt, alpha, m.breakable, after)
+        key = (id(state), dt, alpha, m.breakable, after, None if c is None else c.graph_key())
         if self._graph is None or self._graph[0] != key:
             self._set_clock(t)
             wp.capture_begin(device=m.device)
