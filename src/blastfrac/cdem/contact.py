@@ -78,7 +78,8 @@ still closes; ``BlockContact.losses()`` keeps them apart and ``stored_energy()``
 active contacts.
 
 **Cost.** The hash holds sample points of every edge (rebuilt when a node has moved h_min/4 since the last build,
-checked every 5 steps); an open node that found nothing
+checked every 5 steps: a schedule kept on the device, so that the pass reads nothing back and a graph can hold it,
+``apply``); an open node that found nothing
 within h_min skips the next 10 searches (the same speed bound as the rebuild). Held broken faces, the bulk of a
 crushed zone, would make every step cost what its cracking made (7,000 of 11,900 nodes walking their fan at the
 end of the demo), so the pass works from caches that change only when a spring does (``BlockContact.fan_cache``):
