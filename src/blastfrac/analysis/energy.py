@@ -50,7 +50,8 @@ def rock_energies(model, state) -> dict[str, float]:
         "fracture": fracture,
         "friction": friction,
         "viscous_absorbed": float(acc[VISCOUS_ABSORBED]),
-        "damping": float(acc[DAMPING_DISSIPATED]),
+        "damping": float(acc[DAMPING_DISSIPATED]) + float(np.sum(state.pair_damp.numpy()))
+                   + float(np.sum(state.elem_damp.numpy())),
         "external_work": float(acc[EXTERNAL_WORK]),
     }
 

@@ -10,7 +10,6 @@ import warp as wp
 
 from ..materials.artificial_viscosity import bulk_viscosity
 from ..materials.elastic import jaumann_stress_update
-from ..model.model import DAMPING_DISSIPATED
 
 
 @wp.kernel
@@ -26,12 +25,12 @@ def eval_element_forces(
     q_lin: wp.float64,
     dt: wp.float64,
     f: wp.array(dtype=wp.vec2d),
-    energy_acc: wp.array(dtype=wp.float64),
+    elem_damp: wp.array(dtype=wp.float64),
 ):
     """σ_e ← Jaumann update with L = Σ v_i ⊗ ∇N_i(x^{n-1/2}); f_i = −A·B_iᵀ(σ − qI) at x^n [N/m] (overwrites f).
 
     q is the artificial bulk viscosity [Pa] (materials/artificial_viscosity.py) with l = √A; its
-    dissipation q·(−tr D)·A·Δt [J/m] goes to energy_acc[DAMPING_DISSIPATED].
+    dissipation q·(−tr D)·A·Δt [J/m] goes to the block's own account elem_damp[e].
     """
     e = wp.tid()
     n0 = 3 * e
@@ -66,7 +65,7 @@ def eval_element_forces(
     q = bulk_viscosity(trD, rho, wp.sqrt(area), c_p, q_quad, q_lin)
     if q > wp.float64(0.0):
         s = wp.vec3d(s[0] - q, s[1] - q, s[2])
-        wp.atomic_add(energy_acc, DAMPING_DISSIPATED, -q * trD * area * dt)
+        elem_damp[e] = elem_damp[e] - q * trD * area * dt
     h = wp.float64(-0.5)
     f[n0] = h * wp.vec2d(s[0] * g0[0] + s[2] * g0[1], s[2] * g0[0] + s[1] * g0[1])
     f[n0 + 1] = h * wp.vec2d(s[0] * g1[0] + s[2] * g1[1], s[2] * g1[0] + s[1] * g1[1])
@@ -97,7 +96,7 @@ def launch_element_forces(model, state, dt: float, launch=wp.launch) -> None:
               inputs=[state.x, state.v, state.sigma, wp.float64(model.lam), wp.float64(model.mu),
                       wp.float64(model.density), wp.float64(model.c_p), wp.float64(model.q_quad),
                       wp.float64(model.q_lin), wp.float64(dt)],
-              outputs=[state.f, state.energy_acc], device=model.device)
+              outputs=[state.f, state.elem_damp], device=model.device)
 
 
 def launch_gather_springs(model, state, launch=wp.launch) -> None:

@@ -67,11 +67,13 @@ def integrate_blocks(
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
+    elem_damp: wp.array(dtype=wp.float64),
 ):
     """v^{n+½} of the three nodes of block e with its mass matrix (module doc), then x^{n+1} = x^n + Δt·v^{n+½}.
 
     node_mass: ρA/3 of each node [kg/m]; theta: consistent-mass fraction θ [-]; alpha: Cundall local damping [-].
-    Energy absorbed by dashpots and removed by local damping is accumulated in energy_acc[1], [2] [J/m].
+    Energy absorbed by the boundary dashpots is accumulated in energy_acc[1] (boundary blocks only), the energy the
+    local damping removes in the block's own account elem_damp[e] [J/m].
     """
     e = wp.tid()
     n0 = 3 * e
@@ -103,13 +105,14 @@ def integrate_blocks(
     r0 = wp.vec2d()
     r1 = wp.vec2d()
     r2 = wp.vec2d()
+    damped = wp.float64(0.0)
     for k in range(3):
         n = n0 + k
         vi = v[n]
         fi = f[n]
         if alpha > wp.float64(0.0):
             fd = local_damping(fi, vi, alpha)
-            wp.atomic_add(energy_acc, 2, -wp.dot(fd - fi, vi) * dt)
+            damped = damped - wp.dot(fd - fi, vi) * dt
             fi = fd
         P = eye
         D = zero2
@@ -131,6 +134,8 @@ def integrate_blocks(
             H2 = H
             D2 = D
             r2 = r
+    if alpha > wp.float64(0.0):
+        elem_damp[e] = elem_damp[e] + damped
     s = wp.inverse(eye + (H0 + H1 + H2) * b) @ (H0 @ r0 + H1 @ r1 + H2 @ r2)
     w0 = H0 @ (r0 - s * b)
     w1 = H1 @ (r1 - s * b)
@@ -149,7 +154,7 @@ def launch_integrate(model, state, dt: float, alpha: float, launch=wp.launch) ->
     launch(integrate_blocks, dim=model.element_count,
               inputs=[model.node_mass, model.node_bc, model.bc_P, model.bc_C, state.f,
                       wp.float64(model.mass_theta), wp.float64(alpha), wp.float64(dt)],
-              outputs=[state.x, state.v, state.energy_acc], device=model.device)
+              outputs=[state.x, state.v, state.energy_acc, state.elem_damp], device=model.device)
 
 
 def block_kinetic_energy(m, v, theta: float) -> float:

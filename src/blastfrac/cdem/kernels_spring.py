@@ -14,7 +14,6 @@ from __future__ import annotations
 import warp as wp
 
 from ..materials.interface import spring_dashpot, spring_update_broken, spring_update_intact
-from ..model.model import DAMPING_DISSIPATED
 
 
 @wp.func
@@ -50,7 +49,7 @@ class SpringModel:
 @wp.struct
 class SpringState:
     """Each spring's state (a State's pair_* arrays): force (Fn, Fs) [N/m], strengths, mode, dropped, gap at
-    break g0 [m], break time [s], work and fracture energy [J/m], and the force on its j node [N/m]."""
+    break g0 [m], break time [s], work, fracture energy and dashpot work [J/m], and the force on its j node [N/m]."""
 
     F: wp.array(dtype=wp.vec2d)
     strength: wp.array(dtype=wp.vec2d)
@@ -60,6 +59,7 @@ class SpringState:
     tbreak: wp.array(dtype=wp.float64)
     work: wp.array(dtype=wp.float64)
     efrac: wp.array(dtype=wp.float64)
+    damp: wp.array(dtype=wp.float64)
     force: wp.array(dtype=wp.vec2d)
 
 
@@ -88,6 +88,7 @@ def spring_state(state) -> SpringState:
     ss.F, ss.strength, ss.mode, ss.dropped = state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped
     ss.g0, ss.tbreak, ss.work, ss.efrac, ss.force = (state.pair_g0, state.pair_tbreak, state.pair_work,
                                                     state.pair_efrac, state.pair_force)
+    ss.damp = state.pair_damp
     return ss
 
 
@@ -100,19 +101,19 @@ def eval_spring_forces(
     dt: wp.float64,
     clock: wp.array(dtype=wp.float64),
     first: wp.int32,
-    energy_acc: wp.array(dtype=wp.float64),
 ):
     """Update both springs of interface q; write the force on each pair's j node (global axes) [N/m].
 
     With zeta > 0 a dashpot (materials.interface.spring_dashpot) acts beside each spring that carries
     load (intact, or broken and closed); its force is not part of the stored spring force, so it never
-    enters the failure criteria, and its work goes to energy_acc[DAMPING_DISSIPATED].
+    enters the failure criteria, and its work goes to the pair's own dashpot account ss.damp (no two threads
+    write one address, so the launch can be split or run on a GPU without atomics on a shared total).
 
     With per_pair_law = 1 (a model with joints) each spring takes its friction and softening
     (tanφ, tanφ_r, slope_t, slope_c) from pair_law; otherwise every spring takes the scalars.
 
-    Thread i updates interface first + i (a launch may cover part of the interfaces: two threads, each with its
-    own energy_acc, see CDEMSolver.forces_springs).
+    Thread i updates interface first + i (a launch may cover part of the interfaces: two threads, see
+    CDEMSolver.forces_springs).
     """
     q = wp.tid() + first
     half = wp.float64(0.5)
@@ -186,23 +187,20 @@ def eval_spring_forces(
         if sm.zeta > wp.float64(0.0) and (mode == 0 or fn > wp.float64(0.0)):
             cd = spring_dashpot(v[j] - v[i], nn, tt, kn, ks, sm.node_mass[i], sm.node_mass[j], sm.zeta)
             fv = fv + cd
-            wp.atomic_add(energy_acc, DAMPING_DISSIPATED, -wp.dot(cd, v[j] - v[i]) * dt)
+            ss.damp[k] = ss.damp[k] - wp.dot(cd, v[j] - v[i]) * dt
         ss.force[k] = fv
 
 
 def launch_spring_forces(model, state, dt: float, clock: wp.array, launch=wp.launch, first: int = 0,
-                         count: int | None = None, energy_acc: wp.array | None = None, key=None,
-                         structs: tuple | None = None) -> None:
+                         count: int | None = None, key=None, structs: tuple | None = None) -> None:
     """Interfaces first … first + count − 1 (all by default). clock: [1] the time at the start of the step [s], on
-    the device (set before the step, and before each replay of a captured one); energy_acc: where the dashpots'
-    work goes (state.energy_acc by default); structs: (SpringModel, SpringState) of model and state, if the caller
-    keeps them (CDEMSolver does), else built here."""
+    the device (set before the step, and before each replay of a captured one); structs: (SpringModel,
+    SpringState) of model and state, if the caller keeps them (CDEMSolver does), else built here."""
     count = model.interface_count - first if count is None else count
     if count <= 0:
         return
     sm, ss = structs if structs is not None else (spring_model(model), spring_state(state))
     site = {} if key is None else {"key": key}        # a Launcher's call site (the plain wp.launch has none)
     launch(eval_spring_forces, dim=count,
-           inputs=[sm, ss, state.x, state.v, wp.float64(dt), clock, first,
-                   state.energy_acc if energy_acc is None else energy_acc],
+           inputs=[sm, ss, state.x, state.v, wp.float64(dt), clock, first],
            device=model.device, **site)

@@ -31,10 +31,9 @@ class CDEMSolver:
         self._graph = None
         self.graph_steps = 0
         # Two threads (Simulation with simulation.threads = 2 sets pool): the springs are split in two halves,
-        # the second in the pool's thread with its own energy books (added to state.energy_acc after both)
+        # the second in the pool's thread (each spring keeps its own energy accounts, so nothing is shared)
         self.pool = None
         self.split_min = 10000                    # fewer interfaces: one launch (a hand-off costs ~85 µs here)
-        self._energy_b = wp.zeros(4, dtype=wp.float64, device=model.device)   # energy_acc of the second half
         self._split_ready = False
         # the spring kernel's structs (kernels_spring.SpringModel, SpringState): one model, one per State
         self._spring_model = spring_model(model)
@@ -79,8 +78,7 @@ class CDEMSolver:
     def forces_springs(self, state: State, dt: float, t: float) -> None:
         """3a: springs, failure, broken-pair contact (after it, pair_mode holds this step's failures). With a pool
         (two threads), the second half of the interfaces runs in its thread: each interface writes only its own
-        springs, and the dashpots' work of that half is summed apart and added after (so the energy books differ
-        from one thread's in the last bits; the motion and the spring states do not)."""
+        springs and their energy accounts (dashpot work included), so the result is one thread's to the bit."""
         self._set_clock(t)
         m = self.model
         if self.pool is None or m.interface_count < self.split_min or m.device != "cpu" or not self._split_ready:
@@ -89,13 +87,11 @@ class CDEMSolver:
             return
         half = m.interface_count // 2
         structs = self._springs(state)
-        fut = self.pool.submit(launch_spring_forces, m, state, dt, self.clock, self.launch, half, None,
-                               self._energy_b, "b", structs)
+        fut = self.pool.submit(launch_spring_forces, m, state, dt, self.clock, self.launch, half, None, "b", structs)
         try:
-            launch_spring_forces(m, state, dt, self.clock, self.launch, 0, half, None, "a", structs)
+            launch_spring_forces(m, state, dt, self.clock, self.launch, 0, half, "a", structs)
         finally:
             fut.result()
-        self.launch(add_energy, dim=1, inputs=[self._energy_b], outputs=[state.energy_acc], device=m.device)
 
     def forces_rest(self, state: State, dt: float, t: float) -> None:
         """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode)."""
@@ -177,10 +173,3 @@ class CDEMSolver:
         state.pair_work.assign(stored + np.where(broken, efrac, 0.0))
         return float(efrac[broken].sum())
 
-
-@wp.kernel
-def add_energy(part: wp.array(dtype=wp.float64), energy_acc: wp.array(dtype=wp.float64)):
-    """energy_acc += part, part = 0 (the energy books of a half-launch) [J/m]."""
-    for k in range(part.shape[0]):
-        energy_acc[k] = energy_acc[k] + part[k]
-        part[k] = wp.float64(0.0)
