@@ -185,11 +185,10 @@ def run_reference(src: Path, steps: int = 20, device: str = "cpu") -> list[dict]
     sys.path.insert(0, str(Path(__file__).parent))
     import bench_cdem
     import bench_mpm
+    import reference_port
 
-    scratch = Path(tempfile.mkdtemp(prefix="bench_ref_"))
-    dst = scratch / "ref"
-    shutil.copytree(src, dst)
-    subprocess.run(["bash", "build.sh", sys.executable], cwd=dst, check=True, capture_output=True)
+    dst = reference_port.build(src)
+    scratch = dst.parent
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
 
     def ref(*args, scatter):
@@ -204,6 +203,12 @@ def run_reference(src: Path, steps: int = 20, device: str = "cpu") -> list[dict]
     rows.append({"loop": "CDEM", "size": bc["elements"], "blastfrac_per_s": bc["element_steps_per_s"],
                  "reference_per_s": rc["units_steps_per_s"], "reference_size": rc.get("elements", 199_712),
                  "reference": rc})
+    # the reference's own algorithm in Warp kernels (benchmarks/reference_port.py): Warp's code against g++'s,
+    # and so how much of blastfrac ÷ C++ is blastfrac's extra work
+    port = reference_port.run(dst, device=device)
+    rows.append({"loop": "CDEM, the reference's algorithm in Warp", "size": port["triangles"],
+                 "blastfrac_per_s": port["port_units_steps_per_s"], "reference_per_s": port["cpp_units_steps_per_s"],
+                 "reference_size": port["triangles"], "reference": port})
     for n in (100_000, 400_000):
         rm = ref("mpm", str(n), scatter="private")
         bm = bench_mpm.run((n,), steps, device)[0]
@@ -221,4 +226,12 @@ def reference_markdown(rows: list[dict]) -> str:
     for r in rows:
         out.append(f"| {r['loop']} | {r['size']:,} | {r['blastfrac_per_s']:.3e} | {r['reference_per_s']:.3e} "
                    f"| {r['ratio_time_per_unit']:.2f} |")
+    full = next((r for r in rows if r["loop"] == "CDEM"), None)
+    port = next((r for r in rows if r["loop"].startswith("CDEM, the reference")), None)
+    if full is not None and port is not None:
+        algo = port["blastfrac_per_s"] / full["blastfrac_per_s"]
+        out.append(f"\nCDEM per element-step: blastfrac ÷ C++ {full['ratio_time_per_unit']:.2f} = blastfrac's algorithm ÷ "
+                   f"the reference's, both in Warp, {algo:.2f} × Warp ÷ g++ on one algorithm "
+                   f"{port['ratio_time_per_unit']:.2f} (the port's end state matches the C++ run's checks to "
+                   f"{port['reference']['checks_max_rel_diff']:.1e}, relative)")
     return "\n".join(out)

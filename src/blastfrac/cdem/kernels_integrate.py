@@ -28,9 +28,28 @@ import warp as wp
 
 
 @wp.func
+def sign0(x: wp.float64):
+    """sign(x) with sign(0) = 0 (wp.sign(0) is 1)."""
+    s = wp.float64(0.0)
+    if x > wp.float64(0.0):
+        s = wp.float64(1.0)
+    elif x < wp.float64(0.0):
+        s = wp.float64(-1.0)
+    return s
+
+
+@wp.func
 def local_damping(f: wp.vec2d, v: wp.vec2d, alpha: wp.float64):
-    """Cundall local damping f ← f − α|f|·sign(v), per component (YADE NewtonIntegrator)."""
-    return wp.vec2d(f[0] - alpha * wp.abs(f[0]) * wp.sign(v[0]), f[1] - alpha * wp.abs(f[1]) * wp.sign(v[1]))
+    """Cundall local damping f ← f − α|f|·sign(v), per component (YADE NewtonIntegrator), sign(0) = 0: a component
+    at rest keeps its force (with wp.sign, whose sign(0) is 1, a node at rest had a negative force component
+    scaled by 1 + α and a positive one by 1 − α; until 2026-12-04)."""
+    return wp.vec2d(f[0] - alpha * wp.abs(f[0]) * sign0(v[0]), f[1] - alpha * wp.abs(f[1]) * sign0(v[1]))
+
+
+def np_local_damping(f, v, alpha: float) -> np.ndarray:
+    """NumPy twin of :func:`local_damping` (f, v: [..., 2] [N/m], [m/s])."""
+    f, v = np.asarray(f, float), np.asarray(v, float)
+    return f - alpha * np.abs(f) * np.sign(v)
 
 
 @wp.func

@@ -1,0 +1,235 @@
+"""The compiled reference's CDEM loop written as Warp kernels: what Warp's code generation costs, apart from the algorithm.
+
+    python benchmarks/reference_port.py [--reference ../shared/bench-reference] [--steps 50] [--reps 5]
+
+``../shared/bench-reference/bench_cpp.cpp`` (namespace ``cdem``) steps 199,712 CST triangles that own their nodes,
+two total-displacement springs per interface with tension / Mohr–Coulomb failure and frictional contact after it,
+and local damping. blastfrac's own step does more (an incremental spring with a stored force, strengths, work and
+fracture accounts and a broken-pair frame, a separate owner-computes gather, an updated-Lagrangian Jaumann CST with
+bulk viscosity, a block mass matrix, block contact), so blastfrac ÷ C++ mixes algorithm and code generation. This
+module runs *the reference's algorithm* in three Warp kernels (float64, one launch per interface colour, so a colour
+writes each node once and needs no atomics on a GPU either), on the reference's own initial state
+(``common.cdem_init()`` of a scratch copy), and checks its end state against the C++ run's ``checks`` (momentum,
+kinetic energy, broken springs, stress sums): the same algorithm to round-off. Then
+
+    blastfrac ÷ C++ = (blastfrac ÷ Warp port) × (Warp port ÷ C++),
+
+the first factor being the extra work of blastfrac's algorithm, the second Warp's code against g++ -O3 -march=native.
+``run(ref_dir)`` needs a built copy (``bench_coupled.run_reference`` makes one); ``main`` builds one itself.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+F64 = wp.float64
+
+
+@wp.kernel
+def ref_cst(elem: wp.array2d(dtype=F64), u: wp.array(dtype=wp.vec2d), lam: F64, mu: F64,
+            sigma: wp.array(dtype=wp.vec3d), f: wp.array(dtype=wp.vec2d)):
+    """Small-strain CST of triangle t (elem row: b0 b1 b2 c0 c1 c2 A, B already divided by 2A); assigns f of its
+    three nodes."""
+    t = wp.tid()
+    n0 = 3 * t
+    exx = F64(0.0)
+    eyy = F64(0.0)
+    gxy = F64(0.0)
+    for k in range(3):
+        uk = u[n0 + k]
+        exx += elem[t, k] * uk[0]
+        eyy += elem[t, 3 + k] * uk[1]
+        gxy += elem[t, 3 + k] * uk[0] + elem[t, k] * uk[1]
+    two = F64(2.0)
+    sxx = (lam + two * mu) * exx + lam * eyy
+    syy = lam * exx + (lam + two * mu) * eyy
+    sxy = mu * gxy
+    sigma[t] = wp.vec3d(sxx, syy, sxy)
+    a = elem[t, 6]
+    for k in range(3):
+        bk = elem[t, k]
+        ck = elem[t, 3 + k]
+        f[n0 + k] = wp.vec2d(-a * (bk * sxx + ck * sxy), -a * (ck * syy + bk * sxy))
+
+
+@wp.kernel
+def ref_springs(first: int, ifc: wp.array(dtype=wp.vec4i), X0: wp.array(dtype=wp.vec2d), u: wp.array(dtype=wp.vec2d),
+                L0: wp.array(dtype=F64), kn: F64, ks: F64, ten: F64, coh: F64, tphi: F64, muc: F64,
+                broken: wp.array(dtype=wp.vec2i), f: wp.array(dtype=wp.vec2d)):
+    """Both springs of interface first + tid (nodes a0 a1 of one triangle, b0 b1 of the other): total-displacement
+    forces in the frame of edge a0→a1, failure, frictional contact once broken; scattered to the four nodes (within
+    one colour no node appears twice)."""
+    i = wp.tid() + first
+    q = ifc[i]
+    d = (X0[q[1]] + u[q[1]]) - (X0[q[0]] + u[q[0]])
+    t = d / wp.sqrt(wp.dot(d, d))
+    n = wp.vec2d(t[1], -t[0])
+    area = F64(0.5) * L0[i]
+    br = broken[i]
+    for k in range(2):
+        na = q[k]
+        nb = q[2 + k]
+        du = u[nb] - u[na]
+        fn = kn * area * wp.dot(du, n)
+        fs = ks * area * wp.dot(du, t)
+        b = br[k]
+        if b == 0 and (fn > ten * area or wp.abs(fs) > coh * area + tphi * wp.max(-fn, F64(0.0))):
+            b = 1
+            br[k] = 1
+        if b == 1:
+            fn = wp.min(fn, F64(0.0))
+            lim = muc * wp.abs(fn)
+            fs = wp.min(wp.max(fs, -lim), lim)
+        fv = fn * n + fs * t
+        f[na] = f[na] + fv
+        f[nb] = f[nb] - fv
+    broken[i] = br
+
+
+@wp.kernel
+def ref_integrate(f: wp.array(dtype=wp.vec2d), inv_mass: wp.array(dtype=F64), alpha: F64, dt: F64,
+                  v: wp.array(dtype=wp.vec2d), u: wp.array(dtype=wp.vec2d)):
+    """Local damping f − α|f|·sign(v) per component, then v += Δt·f/m, u += Δt·v."""
+    i = wp.tid()
+    fi = f[i]
+    vi = v[i]
+    w = wp.vec2d()
+    for dd in range(2):
+        sg = F64(0.0)                     # sign(v) with sign(0) = 0, as the C++ has it (wp.sign(0) is 1)
+        if vi[dd] > F64(0.0):
+            sg = F64(1.0)
+        elif vi[dd] < F64(0.0):
+            sg = F64(-1.0)
+        fd = fi[dd] - alpha * wp.abs(fi[dd]) * sg
+        w[dd] = vi[dd] + dt * fd * inv_mass[i]
+    v[i] = w
+    u[i] = u[i] + dt * w
+
+
+class Port:
+    """The reference's CDEM problem on a Warp device, from the float32 initial state of ``common.cdem_init()``."""
+
+    def __init__(self, common, device: str = "cpu"):
+        c, d = common.CDEM, common.cdem_init()
+        self.c, self.device = c, device
+        as64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)      # noqa: E731  (the C++ f64 build widens the same way)
+        self.elem = wp.array(as64(d["elem"]), dtype=F64, device=device)
+        self.X0 = wp.array(as64(d["X0"]), dtype=wp.vec2d, device=device)
+        self.inv_mass = wp.array(as64(d["inv_mass"]), dtype=F64, device=device)
+        self.ifc = wp.array(d["ifc"].astype(np.int32), dtype=wp.vec4i, device=device)
+        self.L0 = wp.array(as64(d["L0"]), dtype=F64, device=device)
+        self.colours = [int(x) for x in d["colour_start"]]
+        self.u0, self.v0, self.broken0 = as64(d["u"]), as64(d["v"]), d["broken"].astype(np.int32)
+        self.u = wp.array(self.u0, dtype=wp.vec2d, device=device)
+        self.v = wp.array(self.v0, dtype=wp.vec2d, device=device)
+        self.broken = wp.array(self.broken0, dtype=wp.vec2i, device=device)
+        self.f = wp.zeros(len(self.u0), dtype=wp.vec2d, device=device)
+        self.sigma = wp.zeros(len(self.elem), dtype=wp.vec3d, device=device)
+        # the constants as the C++ f64 build computes them (float literals read as doubles)
+        E, nu, h = 1.0, 0.25, 1.0 / c["nx"]
+        self.lam, self.mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+        self.kn = 10.0 * E / h
+        self.ks, self.dt = self.kn * 0.5, 0.1 * h
+        self.ntri = len(self.elem)
+
+    def reset(self) -> None:
+        self.u.assign(self.u0)
+        self.v.assign(self.v0)
+        self.broken.assign(self.broken0)
+
+    def step(self) -> None:
+        dev = self.device
+        wp.launch(ref_cst, self.ntri, inputs=[self.elem, self.u, F64(self.lam), F64(self.mu)],
+                  outputs=[self.sigma, self.f], device=dev)
+        c = self.c
+        for k in range(3):
+            a, b = self.colours[k], self.colours[k + 1]
+            wp.launch(ref_springs, b - a, inputs=[a, self.ifc, self.X0, self.u, self.L0, F64(self.kn), F64(self.ks),
+                                                  F64(c["tension"]), F64(c["cohesion"]), F64(c["tan_phi"]),
+                                                  F64(c["mu_contact"])],
+                      outputs=[self.broken, self.f], device=dev)
+        wp.launch(ref_integrate, len(self.u0), inputs=[self.f, self.inv_mass, F64(c["alpha"]), F64(self.dt)],
+                  outputs=[self.v, self.u], device=dev)
+
+    def checks(self, common) -> dict:
+        return common.cdem_checks(self.u.numpy(), self.v.numpy(), self.inv_mass.numpy(), self.broken.numpy(),
+                                  self.sigma.numpy())
+
+
+def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> dict:
+    """Time the Warp port as the C++ program times itself (reset, ``steps`` steps, median over ``reps``) and check
+    its state after the first repetition against the built C++ f64 reference of ``ref_dir`` run on one thread.
+    Returns both RESULTs, the port's checks and the largest relative difference of the checks."""
+    from blastfrac._warp import init_warp
+
+    init_warp()
+    sys.path.insert(0, str(ref_dir))
+    try:
+        import common
+    finally:
+        sys.path.pop(0)
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": "colour", "REPS": str(reps)}
+    r = subprocess.run(["./bench_cpp_f64", "cdem"], cwd=ref_dir, env=env, capture_output=True, text=True, check=True)
+    cpp = json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
+    p = Port(common, device)
+    p.reset()
+    p.step()                                   # load the module (kernel compile or cache read)
+    wp.synchronize_device(device)
+    walls, chk = [], None
+    for k in range(reps):
+        p.reset()
+        wp.synchronize_device(device)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            p.step()
+        wp.synchronize_device(device)
+        walls.append(time.perf_counter() - t0)
+        if k == 0:
+            chk = p.checks(common)
+    step_s = float(np.median(walls)) / steps
+    ref = cpp["checks"]
+    rel = {k: abs(chk[k] - ref[k]) / max(abs(ref[k]), 1e-300) for k in chk}
+    return {"triangles": p.ntri, "port_step_ms": 1e3 * step_s, "port_units_steps_per_s": p.ntri / step_s,
+            "cpp_step_ms": cpp["step_ms_median"], "cpp_units_steps_per_s": cpp["units_steps_per_s"],
+            "port_over_cpp": step_s * 1e3 / cpp["step_ms_median"], "checks": chk, "cpp_checks": ref,
+            "checks_max_rel_diff": max(rel.values()), "device": device}
+
+
+def build(src: Path) -> Path:
+    """A built scratch copy of the reference folder ``src`` (build.sh: g++ -O3 -march=native, data files)."""
+    dst = Path(tempfile.mkdtemp(prefix="bench_ref_")) / "ref"
+    shutil.copytree(src, dst)
+    subprocess.run(["bash", "build.sh", sys.executable], cwd=dst, check=True, capture_output=True)
+    return dst
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--reference", type=Path, default=Path(__file__).resolve().parents[2] / "shared" / "bench-reference")
+    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--device", default="cpu")
+    a = ap.parse_args(argv)
+    d = build(a.reference)
+    try:
+        r = run(d, a.steps, a.reps, a.device)
+    finally:
+        shutil.rmtree(d.parent, ignore_errors=True)
+    print(f"{r['triangles']:,} triangles: Warp port {r['port_step_ms']:.2f} ms/step, C++ f64 1 thread "
+          f"{r['cpp_step_ms']:.2f} ms/step, port / C++ = {r['port_over_cpp']:.2f}; checks agree to "
+          f"{r['checks_max_rel_diff']:.1e} (relative)")
+
+
+if __name__ == "__main__":
+    main()
