@@ -25,15 +25,13 @@ def stored_spring_energy(fn: wp.float64, fs: wp.float64, kn: wp.float64, ks: wp.
 
 @wp.struct
 class SpringModel:
-    """The springs' fixed data (cdem/kernels_spring.py): the nodes of each pair, per-pair stiffness Kn, Ks [N/m per
-    m], area A_c [m], rest length L0 [m], per-pair law (tanφ, tanφ_r, slope_t, slope_c) and the model's scalars."""
+    """The springs' fixed data (cdem/kernels_spring.py): the nodes of each pair, per interface the stiffness Kn, Ks
+    [N/m per m], area A_c [m] and rest length L0 [m] of each of its two pairs, per-pair law (tanφ, tanφ_r, slope_t,
+    slope_c) and the model's scalars."""
 
     pair_i: wp.array(dtype=wp.int32)
     pair_j: wp.array(dtype=wp.int32)
-    kn: wp.array(dtype=wp.float64)
-    ks: wp.array(dtype=wp.float64)
-    ac: wp.array(dtype=wp.float64)
-    l0: wp.array(dtype=wp.float64)
+    spring: wp.array(dtype=wp.vec4d)            # per interface: Kn, Ks, A_c, L0 (both pairs alike)
     law: wp.array(dtype=wp.vec4d)
     node_mass: wp.array(dtype=wp.float64)       # [kg/m]
     tan_phi: wp.float64
@@ -68,8 +66,8 @@ def spring_model(model, sm: SpringModel | None = None) -> SpringModel:
     ``breakable`` during an in-situ stage)."""
     if sm is None:
         sm = SpringModel()
-        sm.pair_i, sm.pair_j, sm.kn, sm.ks = model.pair_i, model.pair_j, model.pair_kn, model.pair_ks
-        sm.ac, sm.l0, sm.law, sm.node_mass = model.pair_ac, model.pair_l0, model.pair_law, model.node_mass
+        sm.pair_i, sm.pair_j, sm.spring = model.pair_i, model.pair_j, model.iface_spring
+        sm.law, sm.node_mass = model.pair_law, model.node_mass
     sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c = model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c
     sm.zeta, sm.per_pair_law, sm.breakable = model.spring_damping, int(model.per_pair_law), int(model.breakable)
     sm.crush = model.crush
@@ -119,44 +117,51 @@ def eval_spring_forces(
     half = wp.float64(0.5)
     pa = 2 * q
     pb = 2 * q + 1
-    ma = half * (x[sm.pair_i[pa]] + x[sm.pair_j[pa]])
-    mb = half * (x[sm.pair_i[pb]] + x[sm.pair_j[pb]])
-    t = wp.normalize(mb - ma)
+    # the interface's constants (Kn, Ks [N/m per m], Ac, L0 [m]; the same for both pairs) and its four nodes
+    c = sm.spring[q]
+    kn = c[0]
+    ks = c[1]
+    ac = c[2]
+    l0 = c[3]
+    ia = sm.pair_i[pa]
+    ja = sm.pair_j[pa]
+    ib = sm.pair_i[pb]
+    jb = sm.pair_j[pb]
+    xia = x[ia]
+    xib = x[ib]
+    t = wp.normalize(half * (xib + x[jb]) - half * (xia + x[ja]))
     n = wp.vec2d(t[1], -t[0])
-    # frame of a broken pair: the e1 face (node-to-face contact of j against the edge i_a→i_b of e1).
-    # The midpoint frame is meaningless once the other pair has opened or the blocks have turned.
-    tb = wp.normalize(x[sm.pair_i[pb]] - x[sm.pair_i[pa]])
-    nb = wp.vec2d(tb[1], -tb[0])
-    nn = n
-    tt = t
+    law = wp.vec4d(sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c)
     for s in range(2):
-        nn = n
-        tt = t
         k = pa + s
         if ss.dropped[k] != 0:
             ss.force[k] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
             continue
-        i = sm.pair_i[k]
-        j = sm.pair_j[k]
-        dd = (v[j] - v[i]) * dt
+        i = ia
+        j = ja
+        if s == 1:
+            i = ib
+            j = jb
+        dv = v[j] - v[i]
+        dd = dv * dt
         dn = wp.dot(dd, n)
         ds = wp.dot(dd, t)
+        nn = n
+        tt = t
         f0 = ss.F[k]
-        kn = sm.kn[k]
-        ks = sm.ks[k]
         fn = wp.float64(0.0)
         fs = wp.float64(0.0)
-        law = wp.vec4d(sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c)
         if sm.per_pair_law != 0:
             law = sm.law[k]
         mode = ss.mode[k]
         if mode == 0:
             st = ss.strength[k]
-            r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, sm.ac[k],
+            r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, ac,
                                      law[0], law[1], law[2], law[3], sm.breakable, sm.crush)
             fn = r[0]
             fs = r[1]
-            ss.strength[k] = wp.vec2d(r[2], r[3])
+            if r[2] != st[0] or r[3] != st[1]:           # softening or broken: most springs keep their strength
+                ss.strength[k] = wp.vec2d(r[2], r[3])
             new_mode = wp.int32(r[4])
             w = ss.work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
             ss.work[k] = w
@@ -165,17 +170,19 @@ def eval_spring_forces(
                 ss.tbreak[k] = clock[0]
                 ss.efrac[k] = w - stored_spring_energy(fn, fs, kn, ks)
         else:
-            nn = nb
-            tt = tb
+            # frame of a broken pair: the e1 face (node-to-face contact of j against the edge i_a→i_b of e1).
+            # The midpoint frame is meaningless once the other pair has opened or the blocks have turned.
+            tt = wp.normalize(xib - xia)
+            nn = wp.vec2d(tt[1], -tt[0])
             dn = wp.dot(dd, nn)
             ds = wp.dot(dd, tt)
             rel = x[j] - x[i]
             gap = wp.dot(rel, nn)
             g0 = ss.g0[k]
             # separated (open by more than L0, slid by L0/2), or crossed by more than L0/2: leave it to §1.5
-            if wp.abs(gap - g0) > half * sm.l0[k] and gap - g0 < wp.float64(0.0):
+            if wp.abs(gap - g0) > half * l0 and gap - g0 < wp.float64(0.0):
                 ss.dropped[k] = 1
-            elif gap - g0 > sm.l0[k] or wp.abs(wp.dot(rel, tt)) > half * sm.l0[k]:
+            elif gap - g0 > l0 or wp.abs(wp.dot(rel, tt)) > half * l0:
                 ss.dropped[k] = 1
             else:
                 r2 = spring_update_broken(f0[1], gap, g0, ds, kn, ks, law[1])
@@ -185,9 +192,9 @@ def eval_spring_forces(
         ss.F[k] = wp.vec2d(fn, fs)
         fv = fn * nn + fs * tt
         if sm.zeta > wp.float64(0.0) and (mode == 0 or fn > wp.float64(0.0)):
-            cd = spring_dashpot(v[j] - v[i], nn, tt, kn, ks, sm.node_mass[i], sm.node_mass[j], sm.zeta)
+            cd = spring_dashpot(dv, nn, tt, kn, ks, sm.node_mass[i], sm.node_mass[j], sm.zeta)
             fv = fv + cd
-            ss.damp[k] = ss.damp[k] - wp.dot(cd, v[j] - v[i]) * dt
+            ss.damp[k] = ss.damp[k] - wp.dot(cd, dv) * dt
         ss.force[k] = fv
 
 

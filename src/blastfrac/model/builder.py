@@ -274,6 +274,7 @@ class ModelBuilder:
             pair_l0=arr(h["pair_l0"], wp.float64),
             pair_t0=arr(h["pair_t0"], wp.float64),
             pair_c0=arr(h["pair_c0"], wp.float64),
+            iface_spring=arr(iface_spring(h), wp.vec4d),
             # per-spring (tanφ, tanφ_r, softening slopes) only with joints; the scalars above otherwise
             pair_law=arr(h["pair_law"] if "pair_law" in h else np.zeros((1, 4)), wp.vec4d),
             per_pair_law=1 if "pair_law" in h else 0,
@@ -288,6 +289,15 @@ class ModelBuilder:
             mass_theta=self.mass_theta,
         )
         return m
+
+
+def iface_spring(h: dict) -> np.ndarray:
+    """(Kn, Ks, Ac, L0) per interface [Q, 4] from the per-pair host arrays, which give both pairs the same values."""
+    cols = [h[k] for k in ("pair_kn", "pair_ks", "pair_ac", "pair_l0")]
+    for c in cols:
+        if not np.array_equal(c[0::2], c[1::2]):
+            raise AssertionError("the two pairs of an interface must share Kn, Ks, Ac and L0")
+    return np.stack([c[0::2] for c in cols], 1) if len(cols[0]) else np.zeros((0, 4))
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
