@@ -291,6 +291,7 @@ class Simulation:
         self.state.energy_acc.zero_()
         self.state.pair_damp.zero_()
         self.state.elem_damp.zero_()
+        self.state.elem_absorbed.zero_()
         self.ppv.ppv.zero_()                         # vibration is the blast's, not the relaxation's
         self.cdem.dt_prev = 0.0
         self.initial_dissipated = self.cdem.rebase_spring_work(self.state)

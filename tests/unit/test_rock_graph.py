@@ -15,7 +15,7 @@ from blastfrac.simulation import Simulation
 from conftest import scenario
 
 STATE = ("x", "v", "f", "sigma", "pair_F", "pair_mode", "pair_dropped", "pair_tbreak", "pair_work", "pair_damp",
-         "elem_damp", "energy_acc")
+         "elem_damp", "elem_absorbed", "energy_acc")
 
 
 def _blast_like(tmp_path, name, contact=False):

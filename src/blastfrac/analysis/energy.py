@@ -49,7 +49,7 @@ def rock_energies(model, state) -> dict[str, float]:
         "springs": float(stored.sum()),
         "fracture": fracture,
         "friction": friction,
-        "viscous_absorbed": float(acc[VISCOUS_ABSORBED]),
+        "viscous_absorbed": float(acc[VISCOUS_ABSORBED]) + float(np.sum(state.elem_absorbed.numpy())),
         "damping": float(acc[DAMPING_DISSIPATED]) + float(np.sum(state.pair_damp.numpy()))
                    + float(np.sum(state.elem_damp.numpy())),
         "external_work": float(acc[EXTERNAL_WORK]),

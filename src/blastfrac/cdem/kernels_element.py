@@ -24,15 +24,16 @@ def eval_element_forces(
     q_quad: wp.float64,
     q_lin: wp.float64,
     dt: wp.float64,
+    first: wp.int32,
     f: wp.array(dtype=wp.vec2d),
     elem_damp: wp.array(dtype=wp.float64),
 ):
     """σ_e ← Jaumann update with L = Σ v_i ⊗ ∇N_i(x^{n-1/2}); f_i = −A·B_iᵀ(σ − qI) at x^n [N/m] (overwrites f).
 
     q is the artificial bulk viscosity [Pa] (materials/artificial_viscosity.py) with l = √A; its
-    dissipation q·(−tr D)·A·Δt [J/m] goes to the block's own account elem_damp[e].
+    dissipation q·(−tr D)·A·Δt [J/m] goes to the block's own account elem_damp[e]. Thread i updates block first + i.
     """
-    e = wp.tid()
+    e = wp.tid() + first
     n0 = 3 * e
     x0 = x[n0]
     x1 = x[n0 + 1]
@@ -77,10 +78,11 @@ def gather_spring_forces(
     node_pairs: wp.array(dtype=wp.vec2i),
     node_pair_sign: wp.array(dtype=wp.vec2d),
     pair_force: wp.array(dtype=wp.vec2d),
+    first: wp.int32,
     f: wp.array(dtype=wp.vec2d),
 ):
-    """f_n += Σ sign·f_pair over the (at most two) springs of node n (owner-computes, no atomics)."""
-    n = wp.tid()
+    """f_n += Σ sign·f_pair over the (at most two) springs of node n = first + tid (owner-computes, no atomics)."""
+    n = wp.tid() + first
     p = node_pairs[n]
     s = node_pair_sign[n]
     acc = f[n]
@@ -91,17 +93,23 @@ def gather_spring_forces(
     f[n] = acc
 
 
-def launch_element_forces(model, state, dt: float, launch=wp.launch) -> None:
-    launch(eval_element_forces, dim=model.element_count,
-              inputs=[state.x, state.v, state.sigma, wp.float64(model.lam), wp.float64(model.mu),
-                      wp.float64(model.density), wp.float64(model.c_p), wp.float64(model.q_quad),
-                      wp.float64(model.q_lin), wp.float64(dt)],
-              outputs=[state.f, state.elem_damp], device=model.device)
+def launch_element_forces(model, state, dt: float, launch=wp.launch, first: int = 0, count: int | None = None,
+                          key=None) -> None:
+    """Blocks first … first + count − 1 (all by default); key: a Launcher's call site (one per range)."""
+    count = model.element_count - first if count is None else count
+    site = {} if key is None else {"key": key}
+    launch(eval_element_forces, dim=count,
+           inputs=[state.x, state.v, state.sigma, wp.float64(model.lam), wp.float64(model.mu),
+                   wp.float64(model.density), wp.float64(model.c_p), wp.float64(model.q_quad),
+                   wp.float64(model.q_lin), wp.float64(dt), first],
+           outputs=[state.f, state.elem_damp], device=model.device, **site)
 
 
-def launch_gather_springs(model, state, launch=wp.launch) -> None:
+def launch_gather_springs(model, state, launch=wp.launch, first: int = 0, count: int | None = None, key=None) -> None:
+    """Nodes first … first + count − 1 (all by default)."""
     if model.interface_count == 0:
         return
-    launch(gather_spring_forces, dim=model.node_count,
-              inputs=[model.node_pairs, model.node_pair_sign, state.pair_force],
-              outputs=[state.f], device=model.device)
+    count = model.node_count - first if count is None else count
+    site = {} if key is None else {"key": key}
+    launch(gather_spring_forces, dim=count, inputs=[model.node_pairs, model.node_pair_sign, state.pair_force, first],
+           outputs=[state.f], device=model.device, **site)

@@ -83,18 +83,19 @@ def integrate_blocks(
     theta: wp.float64,
     alpha: wp.float64,
     dt: wp.float64,
+    first: wp.int32,
     x: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
-    energy_acc: wp.array(dtype=wp.float64),
+    elem_absorbed: wp.array(dtype=wp.float64),
     elem_damp: wp.array(dtype=wp.float64),
 ):
     """v^{n+½} of the three nodes of block e with its mass matrix (module doc), then x^{n+1} = x^n + Δt·v^{n+½}.
 
     node_mass: ρA/3 of each node [kg/m]; theta: consistent-mass fraction θ [-]; alpha: Cundall local damping [-].
-    Energy absorbed by the boundary dashpots is accumulated in energy_acc[1] (boundary blocks only), the energy the
-    local damping removes in the block's own account elem_damp[e] [J/m].
+    The energy the boundary dashpots absorb and the local damping removes go to the block's own accounts
+    elem_absorbed[e] and elem_damp[e] [J/m] (no two threads write one address). Thread i updates block first + i.
     """
-    e = wp.tid()
+    e = wp.tid() + first
     n0 = 3 * e
     half = wp.float64(0.5)
     eye = wp.identity(n=2, dtype=wp.float64)
@@ -165,15 +166,19 @@ def integrate_blocks(
     vm2 = half * (v[n0 + 2] + w2)
     absorbed = wp.dot(vm0, D0 @ vm0) + wp.dot(vm1, D1 @ vm1) + wp.dot(vm2, D2 @ vm2)
     if absorbed != wp.float64(0.0):
-        wp.atomic_add(energy_acc, 1, wp.float64(2.0) * absorbed)
+        elem_absorbed[e] = elem_absorbed[e] + wp.float64(2.0) * absorbed
     store_block(v, x, n0, w0, w1, w2, dt)
 
 
-def launch_integrate(model, state, dt: float, alpha: float, launch=wp.launch) -> None:
-    launch(integrate_blocks, dim=model.element_count,
-              inputs=[model.node_mass, model.node_bc, model.bc_P, model.bc_C, state.f,
-                      wp.float64(model.mass_theta), wp.float64(alpha), wp.float64(dt)],
-              outputs=[state.x, state.v, state.energy_acc, state.elem_damp], device=model.device)
+def launch_integrate(model, state, dt: float, alpha: float, launch=wp.launch, first: int = 0, count: int | None = None,
+                     key=None) -> None:
+    """Blocks first … first + count − 1 (all by default); key: a Launcher's call site (one per range)."""
+    count = model.element_count - first if count is None else count
+    site = {} if key is None else {"key": key}
+    launch(integrate_blocks, dim=count,
+           inputs=[model.node_mass, model.node_bc, model.bc_P, model.bc_C, state.f,
+                   wp.float64(model.mass_theta), wp.float64(alpha), wp.float64(dt), first],
+           outputs=[state.x, state.v, state.elem_absorbed, state.elem_damp], device=model.device, **site)
 
 
 def block_kinetic_energy(m, v, theta: float) -> float:

@@ -14,6 +14,12 @@ from .kernels_integrate import launch_integrate
 from .kernels_spring import launch_spring_forces, spring_model, spring_scalars, spring_state
 
 
+#: per stage, the items from which two threads split it, in units of CDEMSolver.split_min interfaces: a stage is split
+#: where it costs more than ~0.5 ms (per item at 234k triangles on one core: 53 ns a spring interface, 15 ns a CST
+#: block, 4 ns a gathered node, 10 ns an integrated block; two hand-offs of ~85 µs must be paid for)
+SPLIT_SCALE = {"springs": 1, "blocks": 3, "gather": 12, "integrate": 5}
+
+
 class CDEMSolver:
     """Rock forces and integration for a :class:`Model`; scratch buffers are allocated once here."""
 
@@ -30,11 +36,15 @@ class CDEMSolver:
         # Captured rock step (step_captured): None, or (key, graph); graph_steps counts its replays
         self._graph = None
         self.graph_steps = 0
-        # Two threads (Simulation with simulation.threads = 2 sets pool): the springs are split in two halves,
-        # the second in the pool's thread (each spring keeps its own energy accounts, so nothing is shared)
+        # Two threads (Simulation with simulation.threads = 2 sets pool): the springs, the CST blocks, the gather and
+        # the integration each run in two halves, the second in the pool's thread (each item keeps its own energy
+        # accounts, so nothing is shared and the result is one thread's to the bit). A hand-off costs ~85 µs here,
+        # so a stage is split only from SPLIT_SCALE[stage]·split_min items on (split_min interfaces: ~0.5 ms of
+        # springs; the other stages cost less per item)
         self.pool = None
-        self.split_min = 10000                    # fewer interfaces: one launch (a hand-off costs ~85 µs here)
-        self._split_ready = False
+        self.split_min = 10000
+        self._split_ready: set = set()           # the stages whose module has loaded (the first call is serial)
+        self._capturing = False
         # the spring kernel's structs (kernels_spring.SpringModel, SpringState): one model, one per State
         self._spring_model = spring_model(model)
         self._spring_scalars = spring_scalars(model)
@@ -81,22 +91,32 @@ class CDEMSolver:
         springs and their energy accounts (dashpot work included), so the result is one thread's to the bit."""
         self._set_clock(t)
         m = self.model
-        if self.pool is None or m.interface_count < self.split_min or m.device != "cpu" or not self._split_ready:
-            self._split_ready = self.pool is not None            # the first call loads the module, in this thread
-            launch_spring_forces(m, state, dt, self.clock, self.launch, structs=self._springs(state))
+        self._in_halves("springs", m.interface_count, launch_spring_forces, m, state, dt, self.clock, self.launch,
+                        structs=self._springs(state))
+
+    def _in_halves(self, stage: str, n: int, launch, *args, **kwargs) -> None:
+        """``launch(*args, first=…, count=…, key=…, **kwargs)`` over items 0 … n − 1: in two halves, the second in the
+        pool's thread, where there is a pool (two threads), n ≥ SPLIT_SCALE[stage]·split_min, the device is a CPU,
+        no graph is being captured and the stage has run once (its first call loads its module, which Warp does not
+        guard against two threads); else in one launch."""
+        if self.pool is None or n < SPLIT_SCALE[stage] * self.split_min or self.model.device != "cpu" or \
+                self._capturing or stage not in self._split_ready:
+            if self.pool is not None:
+                self._split_ready.add(stage)
+            launch(*args, **kwargs)
             return
-        half = m.interface_count // 2
-        structs = self._springs(state)
-        fut = self.pool.submit(launch_spring_forces, m, state, dt, self.clock, self.launch, half, None, "b", structs)
+        half = n // 2
+        fut = self.pool.submit(launch, *args, first=half, count=n - half, key="b", **kwargs)
         try:
-            launch_spring_forces(m, state, dt, self.clock, self.launch, 0, half, "a", structs)
+            launch(*args, first=0, count=half, key="a", **kwargs)
         finally:
             fut.result()
 
     def forces_rest(self, state: State, dt: float, t: float) -> None:
         """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode)."""
-        launch_element_forces(self.model, state, dt, self.launch)             # 3b CST stress update, f = f_int
-        launch_gather_springs(self.model, state, self.launch)                 # 3c f += spring forces (gather)
+        m = self.model
+        self._in_halves("blocks", m.element_count, launch_element_forces, m, state, dt, self.launch)   # 3b CST, f = f_int
+        self._in_halves("gather", m.node_count, launch_gather_springs, m, state, self.launch)  # 3c f += spring forces
         self.set_pulses(state, t)
         launch_edge_loads(self.model, state, self.dt_prev, self.launch)       # 3d pressure pulses, in-situ tractions
         if self.contact is not None:
@@ -104,7 +124,8 @@ class CDEMSolver:
 
     def integrate(self, state: State, dt: float, alpha: float = 0.0) -> None:
         """Stage 4: central difference with damping, constraints and dashpots."""
-        launch_integrate(self.model, state, dt, alpha, self.launch)
+        self._in_halves("integrate", self.model.element_count, launch_integrate, self.model, state, dt, alpha,
+                        self.launch)
         self.dt_prev = dt
 
     # ------------------------------------------------------------------ captured rock step
@@ -127,6 +148,7 @@ class CDEMSolver:
         if self._graph is None or self._graph[0] != key:
             self._set_clock(t)
             wp.capture_begin(device=m.device)
+            self._capturing = True
             try:
                 launch_spring_forces(m, state, dt, self.clock, self.launch, structs=self._springs(state))
                 self.forces_rest(state, dt, t)
@@ -134,6 +156,7 @@ class CDEMSolver:
                 if after is not None:
                     after()
             finally:
+                self._capturing = False
                 graph = wp.capture_end(device=m.device)
             self._graph = (key, graph)
         self._set_clock(t)                           # the graph's springs read the clock when it runs

@@ -131,6 +131,7 @@ class Model:
             pair_efrac=wp.zeros(p, dtype=wp.float64, device=d),
             pair_damp=wp.zeros(p, dtype=wp.float64, device=d),
             elem_damp=wp.zeros(e, dtype=wp.float64, device=d),
+            elem_absorbed=wp.zeros(e, dtype=wp.float64, device=d),
             ledge_fprev=wp.zeros(2 * self.loaded_edge_count, dtype=wp.vec2d, device=d),
             pulse_values=wp.zeros(max(1, len(self.pulses)), dtype=wp.float64, device=d),
             energy_acc=wp.zeros(4, dtype=wp.float64, device=d),
@@ -164,12 +165,13 @@ class State:
     pair_tbreak: time of failure [s] (−1 while intact)
     pair_work: work done on the spring so far [J/m]; pair_efrac: energy dissipated by its failure [J/m]
     pair_damp: work its dashpot has dissipated so far [J/m]; elem_damp: work the block's bulk viscosity and the
-    local damping of its nodes have dissipated so far [J/m] (one entry per item, written by its own thread only, so
-    no two threads add to one address: the sum is taken when the energies are read, analysis/energy.py)
+    local damping of its nodes have dissipated so far [J/m]; elem_absorbed: work its nodes' boundary dashpots have
+    absorbed so far [J/m] (one entry per item, written by its own thread only, so no two threads add to one address:
+    the sums are taken when the energies are read, analysis/energy.py)
     ledge_fprev: force applied to each loaded-edge node in the previous step (for exact external work)
     pulse_values: current value of each pressure pulse [Pa]
-    energy_acc: accumulated external work, viscous-boundary absorption and contact losses [J/m] (its slot
-    DAMPING_DISSIPATED stays 0: the damping is in pair_damp and elem_damp)
+    energy_acc: accumulated external work and contact losses [J/m] (its slots VISCOUS_ABSORBED and
+    DAMPING_DISSIPATED stay 0: those terms are in elem_absorbed, pair_damp and elem_damp)
     """
 
     x: wp.array
@@ -187,6 +189,7 @@ class State:
     pair_efrac: wp.array
     pair_damp: wp.array
     elem_damp: wp.array
+    elem_absorbed: wp.array
     ledge_fprev: wp.array
     pulse_values: wp.array
     energy_acc: wp.array
