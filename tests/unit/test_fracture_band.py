@@ -118,7 +118,11 @@ def test_thick_blocks_keep_the_energy_joints_stay_brittle_and_the_option_is_chec
     with pytest.raises(ScenarioError, match="fracture_band_width"):
         scenario_from_dict({"rock": {"fracture_band_width": 0.002}, "geometry": geo})
     with pytest.raises(ScenarioError, match=r"rock\.fracture_band_width"):
-        scenario_from_dict({"rock": {"fracture_band_width": 0.0, "tensile_fracture_energy": 50.0}, "geometry": geo})
+        scenario_from_dict({"rock": {"fracture_band_width": -0.001, "tensile_fracture_energy": 50.0}, "geometry": geo})
+    # 0 is "no band" (so that --set can switch off a band a scenario file sets): the scalar law, as with None
+    off = scenario_from_dict({"rock": {"fracture_band_width": 0.0, "tensile_fracture_energy": 50.0}, "geometry": geo})
+    assert off.rock.fracture_band_width is None and "fracture_band_width" not in resolved_dict(off)["rock"]
+    assert "pair_law" not in build(0.003, band=0.0).host
     r = resolved_dict(scenario_from_dict({"rock": {"fracture_band_width": 0.002, "tensile_fracture_energy": 50.0},
                                           "geometry": geo}))["rock"]
     assert r["fracture_band_width"] == 0.002

@@ -206,14 +206,20 @@ class RockConfig(_Strict):
         None, gt=0, description="Mode II fracture energy G_fII [J/m²]; enables linear cohesion softening."
     )
     fracture_band_width: float | None = Field(
-        None, gt=0, le=1.0, description="Width w_c of the fracture process band [m] (not in the paper), (0, 1]; None "
-        "(default): every interface carries the full G_fI, G_fII. Set: an interface whose two blocks have the mean "
+        None, ge=0, le=1.0, description="Width w_c of the fracture process band [m] (not in the paper), (0, 1]; None "
+        "(default) or 0: every interface carries the full G_fI, G_fII (0 lets `--set rock.fracture_band_width=0` "
+        "switch off a band that a scenario file sets, e.g. the confined examples'). Set: an interface whose two blocks have the mean "
         "height h̄ = (A1 + A2)/L < w_c carries the share h̄/w_c of both fracture energies (min(1, h̄/w_c)), so that "
         "fragmenting a region finer than w_c costs 3·G_f/w_c per unit area on any mesh, and a physical crack "
         "resolved by w_c/h̄ parallel lattice cracks costs G_f. Needs a fracture energy. See docs/scenario.md, "
         "'Fracture band'.",
     )
     unbreakable: bool = Field(False, description="Springs never fail (elastic verification runs).")
+
+    @field_validator("fracture_band_width")
+    @classmethod
+    def _band_zero_is_none(cls, v: float | None) -> float | None:
+        return None if v == 0 else v
     block_contact: bool = Field(
         True, description="Node-to-edge frictional contact between blocks whose springs have broken and separated "
         "(METHOD §1.5). Off: separated fragments pass through each other; a run is about 1.7× faster when "
