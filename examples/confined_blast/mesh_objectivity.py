@@ -85,23 +85,26 @@ CASES: dict[str, list[str]] = {
 }
 
 
+def run_case(name: str, scenario: Path, d: Path, overrides: list[str]) -> None:
+    """``blastfrac run scenario --out d --set …`` in a subprocess, unless d holds a summary.json already."""
+    if (d / "summary.json").exists():
+        print(f"{name}: done already")
+        return
+    cmd = [str(Path(sys.executable).with_name("blastfrac")), "run", str(scenario), "--out", str(d)]
+    for o in overrides:
+        cmd += ["--set", o]
+    print(" ".join(cmd), flush=True)
+    t0 = time.time()
+    subprocess.run(cmd, check=True)
+    print(f"{name}: {time.time() - t0:.0f} s", flush=True)
+
+
 def run(names: list[str], out: Path, threads: int = 2) -> None:
+    # as measured: the study predates the example's fracture band (the fb cases set their own, after this)
+    base = ["simulation.progress=false", "output.interval=9e-5", f"simulation.threads={threads}",
+            "rock.fracture_band_width=0"]
     for name in names:
-        d = out / name
-        if (d / "summary.json").exists():
-            print(f"{name}: done already")
-            continue
-        cmd = [str(Path(sys.executable).with_name("blastfrac")), "run", str(SCENARIO), "--out", str(d),
-               "--set", "simulation.progress=false", "--set", "output.interval=9e-5",
-               "--set", f"simulation.threads={threads}",
-               # as measured: the study predates the example's fracture band (the fb cases set their own)
-               "--set", "rock.fracture_band_width=0"]
-        for o in CASES[name]:
-            cmd += ["--set", o]
-        print(" ".join(cmd), flush=True)
-        t0 = time.time()
-        subprocess.run(cmd, check=True)
-        print(f"{name}: {time.time() - t0:.0f} s", flush=True)
+        run_case(name, SCENARIO, out / name, base + CASES[name])
 
 
 def numbers(d: Path) -> dict:

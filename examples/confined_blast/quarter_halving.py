@@ -25,9 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -63,19 +61,12 @@ RING = 0.0025
 
 
 def run(names: list[str], out: Path) -> None:
+    sys.path.insert(0, str(HERE))
+    from mesh_objectivity import run_case
+
     for name in names:
-        d = out / CASES[name][0]
-        if (d / "summary.json").exists():
-            print(f"{name}: done already")
-            continue
-        cmd = [str(Path(sys.executable).with_name("blastfrac")), "run", str(SCENARIO), "--out", str(d), "--no-progress",
-               "--set", "simulation.threads=1"]
-        for o in CASES[name][1]:
-            cmd += ["--set", o]
-        print(" ".join(cmd), flush=True)
-        t0 = time.time()
-        subprocess.run(cmd, check=True)
-        print(f"{name}: {time.time() - t0:.0f} s", flush=True)
+        d, overrides = CASES[name]
+        run_case(name, SCENARIO, out / d, ["simulation.progress=false", "simulation.threads=1"] + overrides)
 
 
 def numbers(d: Path) -> dict:
