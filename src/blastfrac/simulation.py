@@ -66,8 +66,7 @@ class Simulation:
         from .analysis.ppv import PeakVelocity
 
         self.ppv = PeakVelocity(self.model.node_count, self.device)      # peak particle velocity per node
-        self.cdem.ppv_out = self.ppv.ppv                               # updated by the integration kernel
-        self._rock_after = None                                        # nothing after a rock step (graph key)
+        self._rock_after = lambda: self.ppv.update(self.state.v)       # the end of a rock step (one object: a graph key)
         # rock-only steps (no gas, or gas frozen) are replayed from a captured graph where they can be
         # (CDEMSolver.step_captured: bit-identical; False runs every step through the launches)
         self.use_graph = True
@@ -206,12 +205,13 @@ class Simulation:
             self.coupler.add_reactions(st)                 # the gas loads on the rock, in a fixed order
             if self.crack_gas is not None:
                 self.crack_gas.add_loads(st)
-            self._concurrently(lambda: self.cdem.integrate(st, dt, self.alpha),
+            self._concurrently(lambda: (self.cdem.integrate(st, dt, self.alpha), self.ppv.update(st.v)),
                                lambda: self._gas_advance(dt))
         else:
             self.cdem.forces_springs(st, dt, self.time)    # springs + failure
             self.cdem.forces_rest(st, dt, self.time)       # CST, loads, block contact
-            self.cdem.integrate(st, dt, self.alpha)        # central difference on rock nodes, PPV: max |v| per node
+            self.cdem.integrate(st, dt, self.alpha)        # central difference on rock nodes
+            self._rock_after()                             # PPV: max |v| per node
         self.time += dt
         self.steps += 1
         if couple and self.steps % 10 == 0:
