@@ -76,7 +76,7 @@ def stage_times(sim, steps: int) -> dict:
                 if sim.crack_gas is not None:
                     tm("crack gas", lambda: (sim.crack_gas.apply(st, dt), sim.crack_gas.add_loads(st)))
                 tm("P2G + grid", lambda: (sim.gas.to_grid(dt), sim.gas.update_grid(dt)))
-            tm("rock integrate + PPV", lambda: (sim.cdem.integrate(st, dt, sim.alpha), sim.ppv.update(st.v)))
+            tm("rock integrate + PPV", lambda: sim.cdem.integrate(st, dt, sim.alpha))
             if sim.gas is not None:
                 tm("G2P", lambda: sim.gas.to_particles(dt))
                 tm("burn + EOS", lambda: sim.gas.update_eos(dt, sim.time))

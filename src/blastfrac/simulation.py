@@ -66,7 +66,8 @@ class Simulation:
         from .analysis.ppv import PeakVelocity
 
         self.ppv = PeakVelocity(self.model.node_count, self.device)      # peak particle velocity per node
-        self._rock_after = lambda: self.ppv.update(self.state.v)       # the end of a rock step (one object: a graph key)
+        self.cdem.ppv_out = self.ppv.ppv                               # updated by the integration kernel
+        self._rock_after = None                                        # nothing after a rock step (graph key)
         # rock-only steps (no gas, or gas frozen) are replayed from a captured graph where they can be
         # (CDEMSolver.step_captured: bit-identical; False runs every step through the launches)
         self.use_graph = True
@@ -205,13 +206,12 @@ class Simulation:
             self.coupler.add_reactions(st)                 # the gas loads on the rock, in a fixed order
             if self.crack_gas is not None:
                 self.crack_gas.add_loads(st)
-            self._concurrently(lambda: (self.cdem.integrate(st, dt, self.alpha), self.ppv.update(st.v)),
+            self._concurrently(lambda: self.cdem.integrate(st, dt, self.alpha),
                                lambda: self._gas_advance(dt))
         else:
             self.cdem.forces_springs(st, dt, self.time)    # springs + failure
             self.cdem.forces_rest(st, dt, self.time)       # CST, loads, block contact
-            self.cdem.integrate(st, dt, self.alpha)        # central difference on rock nodes
-            self._rock_after()                             # PPV: max |v| per node
+            self.cdem.integrate(st, dt, self.alpha)        # central difference on rock nodes, PPV: max |v| per node
         self.time += dt
         self.steps += 1
         if couple and self.steps % 10 == 0:

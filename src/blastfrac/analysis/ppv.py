@@ -1,7 +1,8 @@
 """Vibration: peak particle velocity (PPV) per rock node, its attenuation law and the damage radius (issue 15).
 
-* **PPV** [m/s]: max over the steps of |v| at each block node (``PeakVelocity.update``, one kernel per step on
-  the half-step velocities the integrator produces), written to the ParaView frames as ``ppv``.
+* **PPV** [m/s]: max over the steps of |v| at each block node, on the half-step velocities, updated by the rock's
+  integration kernel as it writes them (cdem/kernels_integrate.peak_speed; ``PeakVelocity.update`` does the same
+  for velocities integrated elsewhere), written to the ParaView frames as ``ppv``.
 * **Attenuation.** Nodes are binned by their distance R from the nearest borehole centre (log-spaced rings);
   the median PPV of each ring is fitted with PPV = K·(R/√Q)^(−β) by least squares in log–log, over the rings
   outside ``fit_from`` borehole radii. Q [kg/m] is the charge mass per unit thickness of that hole

@@ -45,6 +45,8 @@ class CDEMSolver:
         self.split_min = 10000
         self._split_ready: set = set()           # the stages whose module has loaded (the first call is serial)
         self._capturing = False
+        self.ppv_out: wp.array | None = None     # peak speed per node [m/s] the integration updates (Simulation sets
+                                                 # it to its PeakVelocity array; not saved twice by a checkpoint)
         # the spring kernel's structs (kernels_spring.SpringModel, SpringState): one model, one per State
         self._spring_model = spring_model(model)
         self._spring_scalars = spring_scalars(model)
@@ -123,9 +125,9 @@ class CDEMSolver:
             self.contact.apply(state, dt)                         # 3e node-to-edge block contact
 
     def integrate(self, state: State, dt: float, alpha: float = 0.0) -> None:
-        """Stage 4: central difference with damping, constraints and dashpots."""
+        """Stage 4: central difference with damping, constraints and dashpots (and the PPV, if ``ppv_out`` is set)."""
         self._in_halves("integrate", self.model.element_count, launch_integrate, self.model, state, dt, alpha,
-                        self.launch)
+                        self.launch, ppv=self.ppv_out)
         self.dt_prev = dt
 
     # ------------------------------------------------------------------ captured rock step
