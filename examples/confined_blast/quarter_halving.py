@@ -9,7 +9,7 @@ reproduces the full model's wall load, fracture degree, crack count and length w
 makes a full halving affordable: the shipped mesh (1 mm at the wall, 2.5 mm beyond the refinement zone, as
 scenario_P0.toml) against 0.5 / 1.25 mm, ~2 and ~15 min on one core. Cases (name → overrides):
 
-* ``ship`` / ``half``: the example's law; ``far``: the wall mesh kept, the far mesh halved only;
+* ``ship`` / ``half``: the example's law; ``far`` / ``band_far``: the wall mesh kept, the far mesh halved only;
 * ``band_ship`` / ``band_half``: with ``rock.fracture_band_width = 1 mm`` (docs/scenario.md, "Fracture band": an
   interface between blocks thinner than 1 mm carries the share h̄/w_c of the fracture energies);
 * ``*_x101``: the same with every mesh size × 1.01, a second mesh of the same size (the noise floor).
@@ -49,12 +49,13 @@ CASES: dict[str, tuple[str, list[str]]] = {
     "half": ("h0.00125_n0.0005", HALF),
     "band_ship": ("band_h0.0025", SHIP + BAND),
     "band_half": ("band_h0.00125_n0.0005", HALF + BAND),
+    "band_far": ("band_h0.00125", FAR + BAND),
     "ship_x101": ("h0.0025_x1.01", _x101(SHIP)),
     "band_ship_x101": ("band_h0.0025_x1.01", _x101(SHIP) + BAND),
     "band_half_x101": ("band_h0.00125_n0.0005_x1.01", _x101(HALF) + BAND),
 }
 #: (halved, shipped) pairs the table compares
-PAIRS = (("half", "ship"), ("far", "ship"), ("band_half", "band_ship"), ("band_half_x101", "band_ship_x101"),
+PAIRS = (("half", "ship"), ("far", "ship"), ("band_half", "band_ship"), ("band_far", "band_ship"), ("band_half_x101", "band_ship_x101"),
          ("ship_x101", "ship"), ("band_ship_x101", "band_ship"), ("band_half_x101", "band_half"))
 R_B = 0.005
 RING = 0.0025
