@@ -1,8 +1,8 @@
 """Vibration: peak particle velocity (PPV) per rock node, its attenuation law and the damage radius (issue 15).
 
 * **PPV** [m/s]: max over the steps of |v| at each block node, on the half-step velocities, updated by the rock's
-  integration kernel as it writes them (cdem/kernels_integrate.peak_speed; ``PeakVelocity.update`` does the same
-  for velocities integrated elsewhere), written to the ParaView frames as ``ppv``.
+  integration kernel as it writes them (cdem/kernels_integrate.peak_speed), written to the ParaView frames as
+  ``ppv``.
 * **Attenuation.** Nodes are binned by their distance R from the nearest borehole centre (log-spaced rings);
   the median PPV of each ring is fitted with PPV = K·(R/√Q)^(−β) by least squares in log–log, over the rings
   outside ``fit_from`` borehole radii. Q [kg/m] is the charge mass per unit thickness of that hole
@@ -22,24 +22,13 @@ import numpy as np
 import warp as wp
 
 
-@wp.kernel
-def update_peak_speed(v: wp.array(dtype=wp.vec2d), ppv: wp.array(dtype=wp.float64)):
-    """ppv[i] = max(ppv[i], |v_i|) [m/s]."""
-    i = wp.tid()
-    s = wp.length(v[i])
-    if s > ppv[i]:
-        ppv[i] = s
-
-
 class PeakVelocity:
-    """The running PPV of every rock node (device array ``ppv`` [N], m/s)."""
+    """The running PPV of every rock node (device array ``ppv`` [N], m/s), which the rock's integration kernel
+    updates (CDEMSolver.ppv_out)."""
 
     def __init__(self, n_nodes: int, device: str):
         self.ppv = wp.zeros(max(1, n_nodes), dtype=wp.float64, device=device)
         self.n, self.device = n_nodes, device
-
-    def update(self, v) -> None:
-        wp.launch(update_peak_speed, dim=self.n, inputs=[v], outputs=[self.ppv], device=self.device)
 
     def values(self) -> np.ndarray:
         return self.ppv.numpy()[: self.n]
