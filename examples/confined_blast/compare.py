@@ -56,6 +56,7 @@ def run_numbers(run: Path) -> dict:
         "D_shear": s["fracture_degree"]["D_shear"], "parts": parts,
         "D_horizontal_mean": float(horiz), "D_vertical_mean": float(vert),
         "crushed_zone_radius_over_rb": c["crushed_zone_radius_over_rb"],
+        "damaged_zone_radius_over_rb": c.get("damaged_zone_radius_over_rb", float("nan")),  # runs since stop 26
         "radial_crack_count": c["radial_crack_count"], "longest_radial_crack": c["longest_radial_crack"],
         "insitu_broken": (ins.get("broken_tensile", 0) + ins.get("broken_shear", 0)) if ins else 0,
         "insitu_softening": ins.get("softening", 0) if ins else 0,
@@ -140,6 +141,7 @@ def main(argv=None) -> None:
             ("mean D parts 1-5 (along x)", lambda n: f"{n['D_horizontal_mean']:.3f}"),
             ("mean D parts 6-10 (along y)", lambda n: f"{n['D_vertical_mean']:.3f}"),
             ("crushed zone r_c/r_b", lambda n: f"{n['crushed_zone_radius_over_rb']:.2f}"),
+            ("damaged zone r_d/r_b", lambda n: f"{n['damaged_zone_radius_over_rb']:.2f}"),
             ("radial cracks (max N(R))", lambda n: f"{n['radial_crack_count']}"),
             ("longest radial crack [mm]", lambda n: f"{n['longest_radial_crack'] * 1e3:.0f}"),
             ("energy budget error", lambda n: f"{n['budget_error_relative']:.2%}"),

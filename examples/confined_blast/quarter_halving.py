@@ -16,7 +16,8 @@ scenario_P0.toml) against 0.5 / 1.25 mm, ~2 and ~15 min on one core. Cases (name
 
 ``run`` runs the cases one after the other on one thread each (skipping those done); ``table`` prints the crack
 statistics of summary.json, the cracked fraction and cracked length per area in 2.5 mm rings (all cracked
-interfaces; areas from the blocks, so the quarter's rings are quarter rings), the changes of the halved meshes,
+interfaces; areas from the blocks, so the quarter's rings are quarter rings), the damaged-zone radius r_d
+(docs/results.md), the changes of the halved meshes,
 and writes ``quarter_halving.png`` (the cracks within 70 mm: red tensile and blue shear of the hole's network,
 grey detached) into this folder.
 """
@@ -81,7 +82,7 @@ def numbers(d: Path) -> dict:
             "wall": s["wall_time_s"]}
 
 
-COLS = (("blocks", "blocks", "{:d}"), ("rc", "r_c/r_b", "{:.2f}"), ("longest", "longest from r_c [mm]", "{:.1f}"),
+COLS = (("blocks", "blocks", "{:d}"), ("rc", "r_c/r_b", "{:.2f}"), ("rd", "r_d/r_b", "{:.2f}"), ("longest", "longest from r_c [mm]", "{:.1f}"),
         ("tip", "its tip from the centre [mm]", "{:.1f}"), ("n_rad", "N_rad (quarter)", "{:d}"),
         ("conn", "connected length [m]", "{:.2f}"), ("total", "all cracks [m]", "{:.2f}"), ("r90", "r90 [mm]", "{:.0f}"),
         ("detached", "detached sets", "{:d}"), ("D", "D", "{:.4f}"), ("wall", "wall [s]", "{:.0f}"))
@@ -93,7 +94,7 @@ def profiles(d: Path) -> dict:
     sys.path.insert(0, str(HERE))
     from mesh_objectivity import final_mode
 
-    from blastfrac.analysis.cracks import blast_cracked, connected_network
+    from blastfrac.analysis.cracks import blast_cracked, connected_network, damaged_zone_radius
 
     b, mode = final_mode(d)
     X = b.host["node_X"]
@@ -117,22 +118,25 @@ def profiles(d: Path) -> dict:
     near = np.maximum(np.abs(a).max(axis=1), np.abs(c).max(axis=1)) < 0.07
     seg = {k: np.stack([a[m & near], c[m & near]], 1) for k, m in
            (("detached", cracked & ~connected), ("tensile", connected & tensile), ("shear", connected & ~tensile))}
-    return {"edges": edges, "fraction": frac, "density": dens, "segments": seg}
+    rd = damaged_zone_radius(r, cracked, R_B) / R_B       # also in summary.json of runs made since it was added
+    return {"edges": edges, "fraction": frac, "density": dens, "segments": seg, "rd": rd}
 
 
 def table(out: Path) -> None:
     rows = {n: numbers(out / d) for n, (d, _) in CASES.items() if (out / d / "summary.json").exists()}
+    prof = {n: profiles(out / CASES[n][0]) for n in rows}
+    for n in rows:
+        rows[n]["rd"] = prof[n]["rd"]
     print("| case | " + " | ".join(c[1] for c in COLS) + " |")
     print("|---|" + "---:|" * len(COLS))
     for n, r in rows.items():
         print(f"| {n} | " + " | ".join(f.format(r[k]) for k, _, f in COLS) + " |")
     print("\nchanges [%] (first against second):")
-    keys = ("rc", "longest", "tip", "conn", "total", "r90", "D")
+    keys = ("rc", "rd", "longest", "tip", "conn", "total", "r90", "D")
     print("| pair | " + " | ".join(keys) + " |")
     for a, b in PAIRS:
         if a in rows and b in rows:
             print(f"| {a} vs {b} | " + " | ".join(f"{100 * (rows[a][k] / rows[b][k] - 1):+.0f}" for k in keys) + " |")
-    prof = {n: profiles(out / CASES[n][0]) for n in rows}
     e = next(iter(prof.values()))["edges"] if prof else []
     for what, fmt in (("fraction", "{:.2f}"), ("density", "{:.0f}")):
         print(f"\ncracked {'fraction' if what == 'fraction' else 'length per area [1/m]'} in {RING * 1e3:.1f} mm rings "
@@ -162,18 +166,19 @@ def figure(rows: dict, prof: dict) -> None:
         a.set_aspect("equal")
         a.set_xlabel("x [mm]")
         r = rows[n]
-        a.set_title(f"{n} ({r['blocks']:,} blocks)\nr_c/r_b {r['rc']:.2f}, longest crack tip at {r['tip']:.0f} mm",
+        a.set_title(f"{n} ({r['blocks']:,} blocks)\nr_c/r_b {r['rc']:.2f}, r_d/r_b {r['rd']:.2f}, longest crack tip at {r['tip']:.0f} mm",
                     fontsize=9)
     a = ax[0][-1]
     for n, ls in zip(names, ("-", "--", "-", "--")):
         col = "k" if not n.startswith("band") else "#2ca02c"
         mid = 0.5e3 * (prof[n]["edges"][:-1] + prof[n]["edges"][1:])
-        a.plot(mid, prof[n]["fraction"], ls, color=col, label=n)
+        a.plot(mid, prof[n]["fraction"], ls, color=col, label=f"{n}: r_d = {prof[n]['rd']:.2f} r_b")
+        a.axvline(1e3 * R_B * prof[n]["rd"], ls=ls, color=col, lw=0.7)
     a.axhline(0.5, color="0.6", lw=0.8)
     a.set_xlabel("r [mm]")
     a.set_ylabel(f"cracked fraction of the interfaces, {RING * 1e3:.1f} mm rings")
     a.legend(fontsize=8)
-    a.set_title("black: the example's law; green: fracture band 1 mm", fontsize=9)
+    a.set_title("black: the example's law; green: fracture band 1 mm\nvertical: damaged-zone radius r_d", fontsize=9)
     fig.tight_layout()
     fig.savefig(HERE / "quarter_halving.png", dpi=90)
     print(f"wrote {HERE / 'quarter_halving.png'}")

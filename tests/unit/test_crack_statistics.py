@@ -240,3 +240,31 @@ def test_crack_extent_is_the_radius_enclosing_a_fraction_of_the_cracked_length()
     # ... and uncracked interfaces do not count
     cracked[-1] = False
     assert crack_extent(mid, L2, cracked, np.zeros(2))["crack_extent_r90"] == pytest.approx(0.09)
+
+
+@pytest.mark.parametrize("R1", [2.5 * R_B, 4.0 * R_B])
+@pytest.mark.parametrize("inner, outer", [(1.0, 0.0), (0.6, 0.15)])
+def test_damaged_zone_radius_of_a_drawn_step(model, R1, inner, outer):
+    """Interfaces cracked with probability ``inner`` within R1 and ``outer`` beyond. A ring r_b wide centred at x
+    holds the share s = (R1 − x)/r_b + 1/2 of its interfaces inside R1 (interfaces spread evenly over the ring), so
+    its cracked fraction inner·s + outer·(1 − s) falls to half the first ring's (``inner``) at
+    x = R1 + r_b·(1/2 − (inner/2 − outer)/(inner − outer)): R1 for a sharp edge, R1 + r_b/6 for 0.6 / 0.15,
+    where the absolute threshold of r_c would give R1 − 0.28 r_b."""
+    a, b = _interfaces(model)
+    mid = np.linalg.norm(0.5 * (a + b), axis=1)
+    u = np.random.default_rng(7).random(len(a))
+    cracked = np.where(mid < R1, u < inner, u < outer)
+    s = crack_statistics(model, np.repeat(cracked.astype(np.int32), 2), np.zeros(2), R_B)
+    expect = R1 + R_B * (0.5 - (0.5 * inner - outer) / (inner - outer))
+    print(f"R1 {R1 / R_B:.1f} r_b, {inner}/{outer}: r_d/r_b {s['damaged_zone_radius_over_rb']:.3f} vs "
+          f"{expect / R_B:.3f}; r_c/r_b {s['crushed_zone_radius_over_rb']:.2f}")
+    # the interfaces are not spread quite evenly over a ring (its perimeter grows with r, the mesh coarsens with r
+    # from 1 mm at the wall), which moves the crossing by a few hundredths of r_b; so does the binomial noise of
+    # ~1000 interfaces per ring
+    assert abs(s["damaged_zone_radius"] - expect) < 0.1 * R_B
+
+
+def test_damaged_zone_radius_without_cracks_is_the_wall(model):
+    a, _ = _interfaces(model)
+    s = crack_statistics(model, np.zeros(2 * len(a), np.int32), np.zeros(2), R_B)
+    assert s["damaged_zone_radius"] == R_B

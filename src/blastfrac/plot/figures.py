@@ -256,6 +256,8 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
         frac = np.asarray(p["shattered_arc"]) / (2 * np.pi * np.asarray(p["radius"]))
         ax2.fill_between(R, 0, np.minimum(frac, 1.0), color="0.6", alpha=0.3, lw=0)
         ax.axvline(s["crushed_zone_radius_over_rb"], color=SHEAR_COLOR, lw=0.8, ls=":")
+        if "damaged_zone_radius_over_rb" in s:
+            ax.axvline(s["damaged_zone_radius_over_rb"], color=SHEAR_COLOR, lw=0.8, ls="-.")
     ax.set_xlabel("radius R / r_b [-]")
     ax.set_ylabel("cracks crossing the circle R [-]")
     ax2.set_ylabel("shattered fraction of the circle (grey) [-]")
@@ -263,7 +265,7 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
-    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius)", 90), fontsize=9)
+    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius r_c; dash-dot: damaged-zone radius r_d)", 90), fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
