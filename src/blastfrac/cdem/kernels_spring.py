@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from ..materials.interface import spring_dashpot, spring_update_broken, spring_update_intact
+from ..materials.interface import spring_dashpot_of, spring_update_broken, spring_update_intact
 
 
 @wp.func
@@ -26,14 +26,14 @@ def stored_spring_energy(fn: wp.float64, fs: wp.float64, kn: wp.float64, ks: wp.
 @wp.struct
 class SpringModel:
     """The springs' fixed data (cdem/kernels_spring.py): the nodes of each pair, per interface the stiffness Kn, Ks
-    [N/m per m], area A_c [m] and rest length L0 [m] of each of its two pairs, per-pair law (tanφ, tanφ_r, slope_t,
-    slope_c) and the model's scalars."""
+    [N/m per m], area A_c [m] and rest length L0 [m] of each of its two pairs, per pair the dashpot roots
+    (√(m_eff·Kn), √(m_eff·Ks)) and the law (tanφ, tanφ_r, slope_t, slope_c), and the model's scalars."""
 
     pair_i: wp.array(dtype=wp.int32)
     pair_j: wp.array(dtype=wp.int32)
     spring: wp.array(dtype=wp.vec4d)            # per interface: Kn, Ks, A_c, L0 (both pairs alike)
     law: wp.array(dtype=wp.vec4d)
-    node_mass: wp.array(dtype=wp.float64)       # [kg/m]
+    dashpot: wp.array(dtype=wp.vec2d)           # per pair: √(m_eff·Kn), √(m_eff·Ks) [kg/s per m]
     tan_phi: wp.float64
     tan_phi_r: wp.float64
     slope_t: wp.float64
@@ -67,7 +67,7 @@ def spring_model(model, sm: SpringModel | None = None) -> SpringModel:
     if sm is None:
         sm = SpringModel()
         sm.pair_i, sm.pair_j, sm.spring = model.pair_i, model.pair_j, model.iface_spring
-        sm.law, sm.node_mass = model.pair_law, model.node_mass
+        sm.law, sm.dashpot = model.pair_law, model.pair_dashpot
     sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c = model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c
     sm.zeta, sm.per_pair_law, sm.breakable = model.spring_damping, int(model.per_pair_law), int(model.breakable)
     sm.crush = model.crush
@@ -192,7 +192,7 @@ def eval_spring_forces(
         ss.F[k] = wp.vec2d(fn, fs)
         fv = fn * nn + fs * tt
         if sm.zeta > wp.float64(0.0) and (mode == 0 or fn > wp.float64(0.0)):
-            cd = spring_dashpot(dv, nn, tt, kn, ks, sm.node_mass[i], sm.node_mass[j], sm.zeta)
+            cd = spring_dashpot_of(dv, nn, tt, sm.dashpot[k], sm.zeta)
             fv = fv + cd
             ss.damp[k] = ss.damp[k] - wp.dot(cd, dv) * dt
         ss.force[k] = fv

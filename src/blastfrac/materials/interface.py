@@ -139,9 +139,16 @@ def spring_dashpot(dv: wp.vec2d, n: wp.vec2d, t: wp.vec2d, kn: wp.float64, ks: w
     longer than an element nearly untouched.
     """
     m_eff = mi * mj / (mi + mj)
+    return spring_dashpot_of(dv, n, t, wp.vec2d(wp.sqrt(m_eff * kn), wp.sqrt(m_eff * ks)), zeta)
+
+
+@wp.func
+def spring_dashpot_of(dv: wp.vec2d, n: wp.vec2d, t: wp.vec2d, root: wp.vec2d, zeta: wp.float64):
+    """:func:`spring_dashpot` from root = (√(m_eff·Kn), √(m_eff·Ks)) [kg/s per m], which the model keeps per pair
+    (Model.pair_dashpot): the spring kernel then reads two numbers instead of two node masses and two roots."""
     two = wp.float64(2.0)
-    cn = two * zeta * wp.sqrt(m_eff * kn)
-    cs = two * zeta * wp.sqrt(m_eff * ks)
+    cn = two * zeta * root[0]
+    cs = two * zeta * root[1]
     return -(cn * wp.dot(dv, n)) * n - (cs * wp.dot(dv, t)) * t
 
 

@@ -275,6 +275,7 @@ class ModelBuilder:
             pair_t0=arr(h["pair_t0"], wp.float64),
             pair_c0=arr(h["pair_c0"], wp.float64),
             iface_spring=arr(iface_spring(h), wp.vec4d),
+            pair_dashpot=arr(pair_dashpot(h, self.topology.pair_nodes), wp.vec2d),
             # per-spring (tanφ, tanφ_r, softening slopes) only with joints; the scalars above otherwise
             pair_law=arr(h["pair_law"] if "pair_law" in h else np.zeros((1, 4)), wp.vec4d),
             per_pair_law=1 if "pair_law" in h else 0,
@@ -289,6 +290,15 @@ class ModelBuilder:
             mass_theta=self.mass_theta,
         )
         return m
+
+
+def pair_dashpot(h: dict, pair_nodes: np.ndarray) -> np.ndarray:
+    """(√(m_eff·Kn), √(m_eff·Ks)) per pair [2Q, 2] [kg/s per m], m_eff = m_i m_j/(m_i + m_j) of its two nodes: the
+    spring dashpot's coefficients without 2ζ, in the operations of materials.interface.spring_dashpot (so the
+    kernel's dashpot is the one that function gives, to the bit)."""
+    mi, mj = h["node_mass"][pair_nodes[:, 0]], h["node_mass"][pair_nodes[:, 1]]
+    m_eff = mi * mj / (mi + mj)
+    return np.stack([np.sqrt(m_eff * h["pair_kn"]), np.sqrt(m_eff * h["pair_ks"])], 1).reshape(-1, 2)
 
 
 def iface_spring(h: dict) -> np.ndarray:

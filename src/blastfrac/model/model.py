@@ -30,6 +30,8 @@ class Model:
     pair_kn, pair_ks: spring stiffness K = k·Ac [N/m per m], [P]
     pair_ac: tributary area Ac (edge length/2, unit thickness) [m], [P]
     iface_spring: (Kn, Ks, Ac, L0) per interface, shared by its two pairs, [Q] vec4d (what the spring kernel reads)
+    pair_dashpot: (√(m_eff·Kn), √(m_eff·Ks)) per pair [kg/s per m], m_eff = m_i m_j/(m_i + m_j): the dashpot
+        coefficients 2ζ√(m_eff K) without 2ζ (materials.interface.spring_dashpot), [2Q] vec2d
     pair_l0: length of the edge the spring belongs to [m], [P]
     pair_t0, pair_c0: initial tensile strength and cohesion [Pa], [P]
     pair_law: per-spring (tanφ, tanφ_r, slope_t, slope_c), [P] vec4d, read only when per_pair_law = 1 (a model
@@ -71,6 +73,7 @@ class Model:
     pair_t0: wp.array
     pair_c0: wp.array
     iface_spring: wp.array
+    pair_dashpot: wp.array
     ledge_n0: wp.array
     ledge_n1: wp.array
     ledge_pulse: wp.array
