@@ -111,12 +111,11 @@ def group_crossings(theta: np.ndarray, R: float, w: float) -> list[tuple[float, 
     return groups
 
 
-def local_mesh_size(a: np.ndarray, b: np.ndarray, center: np.ndarray, R: float) -> float:
-    """Median length [m] of the interfaces a→b that cross the circle R (the mesh size along that circle)."""
-    ra = np.linalg.norm(a - center, axis=1)
-    rb = np.linalg.norm(b - center, axis=1)
+def local_mesh_size(ra: np.ndarray, rb: np.ndarray, length: np.ndarray, R: float) -> float:
+    """Median length [m] of the interfaces that cross the circle R (the mesh size along that circle); ra, rb: the
+    distances [m] of each interface's two ends from the centre, length: its length [m]."""
     hit = (ra - R) * (rb - R) <= 0.0
-    return float(np.median(np.linalg.norm(b[hit] - a[hit], axis=1))) if hit.any() else 0.0
+    return float(np.median(length[hit])) if hit.any() else 0.0
 
 
 def crossing_profile(a, b, cracked, tensile, center, radii, connected=None) -> dict:
@@ -133,8 +132,9 @@ def crossing_profile(a, b, cracked, tensile, center, radii, connected=None) -> d
     masks = {"count": cracked & connected, "count_tensile": tensile & connected, "count_all": cracked}
     narrow = {k: [] for k in masks}
     shattered, sizes = [], []
+    ra, rb, length = np.linalg.norm(a - center, axis=1), np.linalg.norm(b - center, axis=1), np.linalg.norm(b - a, axis=1)
     for R in radii:
-        w = local_mesh_size(a, b, center, R)
+        w = local_mesh_size(ra, rb, length, R)
         for k, m in masks.items():
             g = group_crossings(circle_crossings(a[m], b[m], center, R), R, w)
             narrow[k].append([t for t, arc, _ in g if arc <= NARROW_ARC * w])
