@@ -118,7 +118,7 @@ def profiles(d: Path) -> dict:
     near = np.maximum(np.abs(a).max(axis=1), np.abs(c).max(axis=1)) < 0.07
     seg = {k: np.stack([a[m & near], c[m & near]], 1) for k, m in
            (("detached", cracked & ~connected), ("tensile", connected & tensile), ("shear", connected & ~tensile))}
-    rd = damaged_zone_radius(r, cracked, R_B) / R_B       # also in summary.json of runs made since it was added
+    rd = damaged_zone_radius(r, cracked, R_B)[0] / R_B       # also in summary.json of runs made since it was added
     return {"edges": edges, "fraction": frac, "density": dens, "segments": seg, "rd": rd}
 
 

@@ -262,9 +262,20 @@ def test_damaged_zone_radius_of_a_drawn_step(model, R1, inner, outer):
     # from 1 mm at the wall), which moves the crossing by a few hundredths of r_b; so does the binomial noise of
     # ~1000 interfaces per ring
     assert abs(s["damaged_zone_radius"] - expect) < 0.1 * R_B
+    assert s["damaged_zone_radius_censored"] is False
 
 
 def test_damaged_zone_radius_without_cracks_is_the_wall(model):
     a, _ = _interfaces(model)
     s = crack_statistics(model, np.zeros(2 * len(a), np.int32), np.zeros(2), R_B)
     assert s["damaged_zone_radius"] == R_B
+
+
+def test_damaged_zone_radius_of_rock_cracked_throughout_is_censored(model):
+    """A third of the interfaces cracked everywhere: the fraction never halves, so r_d is the last ring's centre
+    (within one ring width r_b of the disc's edge, 0.12 m) and flagged as a lower bound."""
+    a, b = _interfaces(model)
+    cracked = np.random.default_rng(3).random(len(a)) < 1 / 3
+    s = crack_statistics(model, np.repeat(cracked.astype(np.int32), 2), np.zeros(2), R_B)
+    assert s["damaged_zone_radius_censored"] is True
+    assert 0.12 - R_B <= s["damaged_zone_radius"] <= 0.12

@@ -23,7 +23,7 @@ from the hole centre.
   size wide, and the fraction sits near one half over the first two borehole radii, so two meshes of the same
   size gave r_c 17–51 % apart, r_d 1–9 % (examples/confined_blast/mesh_study.md, "The crushed zone").
   r_d = r_b when the first ring has no crack; when the fraction never falls to half within the mesh, r_d is
-  the centre of the last ring that holds interfaces.
+  the centre of the last ring that holds interfaces, a lower bound (``damaged_zone_radius_censored``).
 * **Connected network** (of this hole): the crack sets that have a vertex on the wall, or, when r_c > r_b,
   a vertex at r ≤ r_c (the crushed zone touches the wall by construction). All other crack sets are
   **detached**: they are reported apart (number, total length, number of those of more than ``MIN_EXTENT``
@@ -265,10 +265,12 @@ def crushed_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float, w: float
         r_c = r_b + k * w
 
 
-def damaged_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float) -> float:
+def damaged_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float) -> tuple[float, bool]:
     """Damaged-zone radius r_d [m]: where the cracked fraction in rings r_b wide falls to half its first ring's.
 
     ``r``: midpoint radius of each interface [m]; ``cracked``: mask over the interfaces; r_b: borehole radius [m].
+    Returns (r_d, censored): censored is True when the fraction does not fall to half within the mesh, r_d then
+    being the centre of the last ring that holds interfaces (a lower bound).
     """
     order = np.argsort(r)
     r, c = r[order], np.cumsum(cracked[order].astype(np.int64))
@@ -281,7 +283,7 @@ def damaged_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float) -> float
     x0 = 1.5 * r_b
     f0 = fraction(x0)
     if not f0 > 0.0:
-        return r_b
+        return r_b, False
     x_prev, f_prev = x0, f0
     for k in range(1, int(np.ceil((r[-1] - x0) / (DAMAGE_STEP * r_b))) + 1):
         x = x0 + k * DAMAGE_STEP * r_b
@@ -289,9 +291,9 @@ def damaged_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float) -> float
         if np.isnan(f):
             break
         if f < 0.5 * f0:
-            return float(x_prev + (x - x_prev) * (f_prev - 0.5 * f0) / (f_prev - f))
+            return float(x_prev + (x - x_prev) * (f_prev - 0.5 * f0) / (f_prev - f)), False
         x_prev, f_prev = x, f
-    return float(x_prev)
+    return float(x_prev), True
 
 
 def connected_network(model, cracked: np.ndarray, center: np.ndarray, r_b: float) -> dict:
@@ -361,7 +363,8 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
     w, r_c, connected = net["w"], net["r_c"], net["connected"]
     mid_r = np.linalg.norm(0.5 * (a + b) - center, axis=1)
     joint = joint_interface_mask(model)
-    r_d = damaged_zone_radius(mid_r, cracked, r_b) if joint is None else damaged_zone_radius(mid_r[~joint], cracked[~joint], r_b)
+    r_d, r_d_censored = damaged_zone_radius(mid_r, cracked, r_b) if joint is None else \
+        damaged_zone_radius(mid_r[~joint], cracked[~joint], r_b)
     # crack crossings of circles outside the crushed zone
     r_max = float(np.linalg.norm(np.concatenate([a, b]) - center, axis=1).max())
     radii = np.arange(r_c + 2 * w, r_max, w)
@@ -380,6 +383,7 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
         "crushed_zone_radius_over_rb": r_c / r_b,
         "damaged_zone_radius": r_d,
         "damaged_zone_radius_over_rb": r_d / r_b,
+        "damaged_zone_radius_censored": r_d_censored,
         "radial_crack_count": n_rad,
         "radial_crack_count_radius": r_at,
         "radial_crack_count_tensile": int(max(prof["count_tensile"], default=0)),
