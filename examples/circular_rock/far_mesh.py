@@ -26,6 +26,7 @@ def numbers(d: Path) -> dict:
     s = json.loads((d / "summary.json").read_text())
     c, fd = s["cracks"][0], s["fracture_degree"]
     row = {"elements": s["counts"]["elements"], "wall": s["wall_time_s"], "rc": c["crushed_zone_radius_over_rb"],
+           "rd": c.get("damaged_zone_radius_over_rb", float("nan")),                 # in runs since stop 26
            "n_rad": c["radial_crack_count"], "n_rad_r": 1e3 * c["radial_crack_count_radius"],
            "longest": 1e3 * c["longest_radial_crack"], "conn_len": c["connected_crack_length"],
            "total_len": c["crack_length_total"], "D": fd["D"], "budget": 100 * s["energy"]["budget_error_relative"]}
@@ -48,19 +49,19 @@ def main() -> None:
                    "simulation.progress=false"]
             subprocess.run(cmd, check=True)
         rows[h] = numbers(d)
-    head = ("far h [mm] | blocks | r_c/r_b | connected radial cracks (at R [mm]) | longest [mm] | connected length [m] |"
+    head = ("far h [mm] | blocks | r_c/r_b | r_d/r_b | connected radial cracks (at R [mm]) | longest [mm] | connected length [m] |"
             " all cracks [m] | D | " + " | ".join(f"D {z}" for z in ZONES) + " | budget [%] | wall [s]")
     print("| " + head + " |")
     print("|" + "---:|" * (head.count("|") + 1))
     for h, r in rows.items():
-        print(f"| {h * 1000:g} | {r['elements']} | {r['rc']:.2f} | {r['n_rad']} ({r['n_rad_r']:.0f}) | "
+        print(f"| {h * 1000:g} | {r['elements']} | {r['rc']:.2f} | {r['rd']:.2f} | {r['n_rad']} ({r['n_rad_r']:.0f}) | "
               f"{r['longest']:.0f} | {r['conn_len']:.2f} | {r['total_len']:.2f} | {r['D']:.3f} | "
               + " | ".join(f"{r[z]:.2f}" for z in ZONES) + f" | {r['budget']:.2f} | {r['wall']:.0f} |")
     pairs = list(rows)
     for coarse, fine in zip(pairs, pairs[1:]):
         a_, b_ = rows[coarse], rows[fine]
         print(f"{coarse * 1000:g} → {fine * 1000:g} mm: " + ", ".join(
-            f"{k} {100 * (b_[k] / a_[k] - 1):+.0f} %" for k in ("rc", "n_rad", "longest", "conn_len", "total_len",
+            f"{k} {100 * (b_[k] / a_[k] - 1):+.0f} %" for k in ("rc", "rd", "n_rad", "longest", "conn_len", "total_len",
                                                                 "D", *ZONES)))
     _figure(a.out, rows)
 
