@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
+from .._warp import Launcher
+
 
 @wp.kernel
 def accumulate_wall_impulse(nodes: wp.array(dtype=wp.int32), hole: wp.array(dtype=wp.int32),
@@ -69,12 +71,13 @@ class WallLoad:
         self.acc = wp.zeros(max(1, self.n_holes), dtype=wp.float64, device=device)
         self.device = device
         self._t_last = 0.0
+        self._launch = Launcher()                    # a recorded launch, replayed each step (_warp.Launcher)
 
     def accumulate(self, f_react, dt: float) -> None:
         if self.count:
-            wp.launch(accumulate_wall_impulse, dim=self.count,
-                      inputs=[self.nodes, self.hole, self.rhat, f_react, wp.float64(dt)], outputs=[self.acc],
-                      device=self.device)
+            self._launch(accumulate_wall_impulse, dim=self.count,
+                         inputs=[self.nodes, self.hole, self.rhat, f_react, wp.float64(dt)], outputs=[self.acc],
+                         device=self.device)
 
     def sample(self, t: float) -> list[float]:
         """Mean wall pressure of each hole since the last sample [Pa] (0 at the first); resets the impulse."""

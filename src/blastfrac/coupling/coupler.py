@@ -153,13 +153,15 @@ class GasRockCoupler:
         (kept inside the kernels: each step's work with the mean of the velocities before and after it, see
         ``energies``). Reads state.x, state.v and state.pair_mode only, so it may run
         beside the rock's force stages once the springs have failed for this step."""
+        mpm, m = self.mpm, self.model
+        w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
+        # over the nodes of the list that the last step's forces came from: before a rebuild replaces it
+        n_nodes = 3 * self.n_exposed
+        self._launch(account_rock_work_and_clear, dim=max(1, n_nodes),
+                     inputs=[self.elems, n_nodes, self.f_react, state.v, w_old, self.acc], device=m.device)
         if self._since >= self.rebuild_interval:
             self._rebuild(state)
         self._since += 1
-        mpm, m = self.mpm, self.model
-        w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
-        self._launch(account_rock_work_and_clear, dim=m.node_count, inputs=[self.f_react, state.v, w_old, self.acc],
-                     device=m.device)
         self._dt_work = dt
         self._w_react = 0.5 * dt                          # add_reactions books the first half of this step's
         if self.n_exposed == 0:
@@ -185,9 +187,10 @@ class GasRockCoupler:
 
     def add_reactions(self, state) -> None:
         """state.f += this step's contact reactions (f_react), and the first half of their work at the rock's
-        velocities before the step."""
-        self._launch(add_reactions_with_work, dim=self.model.node_count,
-                     inputs=[state.f, self.f_react, state.v, self._w_react, self.acc], device=self.model.device)
+        velocities before the step; over the nodes of the listed elements, the only ones the contacts load."""
+        self._launch(add_reactions_with_work, dim=3 * self.n_exposed,
+                     inputs=[self.elems, state.f, self.f_react, state.v, self._w_react, self.acc],
+                     device=self.model.device)
         if self.contact_heating:                          # the contacts' dissipation so far heats the gas in contact
             self._launch(heat_gas_from_contacts, dim=self.mpm.n, inputs=[self.acc, self.diss_p],
                          outputs=[self.mpm.ie], device=self.model.device)

@@ -265,8 +265,17 @@ def accumulate_gas_contact_work(
         wp.atomic_add(acc, ACC_ABSORBED, -w * pw)
 
 
+@wp.func
+def listed_node(elems: wp.array(dtype=wp.int32), i: int):
+    """The i-th node of the listed elements' nodes, in the list's order (each block has its own three nodes,
+    3e … 3e + 2, so the nodes of the list are distinct)."""
+    return 3 * elems[i / 3] + i % 3
+
+
 @wp.kernel
 def account_rock_work_and_clear(
+    elems: wp.array(dtype=wp.int32),
+    n_nodes: int,
     f_react: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
     w: wp.float64,
@@ -276,7 +285,11 @@ def account_rock_work_and_clear(
     second half, w = ½Δt [s]), then f_react = 0 for this step's; and the per-step books acc[STORED] and
     acc[CONTACTS] start again from 0 (thread 0: the contact kernel fills them after this one). Thread 0 also books
     the heat the last step handed to the gas (acc[HEAT_NEW], heat_gas_from_contacts): it leaves the contacts' book
-    (absorbed −= it, atomically, beside the other threads' adds) into acc[HEATED], so the budget is unchanged."""
+    (absorbed −= it, atomically, beside the other threads' adds) into acc[HEATED], so the budget is unchanged.
+
+    Only the nodes of the listed elements (elems, the list the last step's contact kernel searched; n_nodes = 3 × its
+    length) can carry a reaction, so the launch covers them (at least one thread, for the books) and not the whole
+    rock: on a CPU the list is in element order, so the sum is the one over all nodes, whose other terms are 0."""
     i = wp.tid()
     if i == 0:
         acc[ACC_STORED] = wp.float64(0.0)
@@ -287,15 +300,19 @@ def account_rock_work_and_clear(
             wp.atomic_add(acc, ACC_ABSORBED, -q)
             acc[ACC_HEATED] = acc[ACC_HEATED] + q
             acc[ACC_HEAT_NEW] = wp.float64(0.0)
-    f = f_react[i]
+    if i >= n_nodes:
+        return
+    n = listed_node(elems, i)
+    f = f_react[n]
     if f[0] != wp.float64(0.0) or f[1] != wp.float64(0.0):
         if w != wp.float64(0.0):
-            wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(f, v[i]))
-        f_react[i] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
+            wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(f, v[n]))
+        f_react[n] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
 
 
 @wp.kernel
 def add_reactions_with_work(
+    elems: wp.array(dtype=wp.int32),
     f: wp.array(dtype=wp.vec2d),
     f_react: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
@@ -303,13 +320,14 @@ def add_reactions_with_work(
     acc: wp.array(dtype=wp.float64),
 ):
     """f += f_react [N/m] (the gas loads on the rock nodes, after the rock's own forces) and acc[ABSORBED] −= w·f·v,
-    their work at the velocities v [m/s] before the step over w = ½Δt [s] (the first half)."""
-    i = wp.tid()
-    a = f_react[i]
+    their work at the velocities v [m/s] before the step over w = ½Δt [s] (the first half); one thread per node of
+    the listed elements (elems), the only nodes the contact kernel loads."""
+    n = listed_node(elems, wp.tid())
+    a = f_react[n]
     if a[0] != wp.float64(0.0) or a[1] != wp.float64(0.0):
-        f[i] = f[i] + a
+        f[n] = f[n] + a
         if w != wp.float64(0.0):
-            wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(a, v[i]))
+            wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(a, v[n]))
 
 
 @wp.kernel
