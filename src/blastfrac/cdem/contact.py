@@ -127,6 +127,7 @@ import warp as wp
 from .._warp import Launcher
 from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh, ContactParams
 from .contact_fan import (
+    append_vertices,
     list_candidates,
     mark_pair_changes,
     refresh_fan_cache,
@@ -232,7 +233,8 @@ class BlockContact:
         self.rebuild_skin = 0.25 * self.h_min                          # [m]
         self._built = False
         self._x_build = wp.zeros(n, dtype=wp.vec2d, device=d)         # node positions when the hash was built
-        self._moved = wp.zeros(1, dtype=wp.float64, device=d)          # largest squared displacement since [m²]
+        self._moved = wp.zeros(2, dtype=wp.float64, device=d)          # largest squared displacement since [m²]
+        #                                                                 (of each half of the nodes)
         # the schedule on the device (contact_tick): step count and steps since the build (checked at the first
         # call), the two branch flags of wp.capture_if, the number of builds
         self._clock = wp.array([0, self.rebuild_check], dtype=wp.int32, device=d)
@@ -273,7 +275,15 @@ class BlockContact:
         self.fan_cand = wp.zeros((n, int(FAN_CACHE)), dtype=wp.int32, device=d)
         self.fan_count = wp.full(n, -1, dtype=wp.int32, device=d)     # −1: not cached, walk the fan
         self.vertex_count = int(vertex.max()) + 1
-        self._dirty_vertices = wp.zeros(self.vertex_count, dtype=wp.int32, device=d)
+        # the vertices whose caches are stale; the second half of the springs lists its own (dirty_b), appended to
+        # the first's: a vertex may then be listed by both halves, so the joined list holds up to twice the vertices
+        self._dirty_vertices = wp.zeros(2 * self.vertex_count, dtype=wp.int32, device=d)
+        self._dirty_b = wp.zeros(self.vertex_count, dtype=wp.int32, device=d)
+        self._counts_b = wp.zeros(1, dtype=wp.int32, device=d)
+        # CDEMSolver._in_halves, where the solver runs stages in two threads (it sets this): the scan of the springs'
+        # changes and the displacement check, both over the whole rock, then run in two halves
+        self.in_halves = None
+        self._b_listed = False
         self._cache_fresh = False
         self._counts = wp.zeros(2, dtype=wp.int32, device=d)          # dirty vertices, listed nodes
         self._node_list = wp.zeros(n, dtype=wp.int32, device=d)       # the nodes of this step's contact pass
@@ -347,10 +357,11 @@ class BlockContact:
         if use_cache:
             # caches of the vertices where a spring changed state since the last call (of every vertex at first)
             if m.spring_count:
-                self._launch(mark_pair_changes, m.spring_count,
-                             [state.pair_mode, state.pair_dropped, self.pair_vertex, self._clock, self.seen_mode,
-                              self.seen_dropped, self.vertex_stamp, self._counts, self._dirty_vertices,
-                              self.iface_slots, self.slot_samples, self.sample_pos, self.sorted_code])
+                self._halves("pair_changes", m.spring_count, self._mark_pair_changes, state)
+                if self._b_listed:
+                    self._launch(append_vertices, 1, [self._counts, self._dirty_vertices, self._counts_b,
+                                                      self._dirty_b])
+                    self._b_listed = False
             if not self._cache_fresh:
                 self._refresh(state, 1)
             else:
@@ -369,6 +380,35 @@ class BlockContact:
                      [node_list, counts, stride, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist, prm,
                       state.pair_mode, state.pair_dropped, state.x, state.v, self._clock, float(dt), state.f,
                       state.energy_acc])
+
+    def _halves(self, stage: str, n: int, launch, *args) -> None:
+        """``launch(*args, first=…, count=…, key=…)`` over items 0 … n − 1, in two halves on two threads where the
+        solver gives ``in_halves`` (see CDEMSolver._in_halves), else in one launch."""
+        if self.in_halves is None:
+            launch(*args)
+        else:
+            self.in_halves(stage, n, launch, *args)
+
+    def _mark_pair_changes(self, state, first: int = 0, count: int | None = None, key=None) -> None:
+        """mark_pair_changes over springs first … first + count − 1; the second half (first > 0) lists into its own
+        buffer, which append_vertices then joins to the first's."""
+        n = self.model.spring_count
+        count = n - first if count is None else count
+        second = first > 0
+        if second:
+            self._counts_b.zero_()
+        self._launch(mark_pair_changes, count,
+                     [first, state.pair_mode, state.pair_dropped, self.pair_vertex, self._clock, self.seen_mode,
+                      self.seen_dropped, self.vertex_stamp, self._counts_b if second else self._counts,
+                      self._dirty_b if second else self._dirty_vertices, self.iface_slots, self.slot_samples,
+                      self.sample_pos, self.sorted_code], key=key)
+        self._b_listed = self._b_listed or second        # joined by _join_halves once both halves have run
+
+    def _largest_displacement(self, state, first: int = 0, count: int | None = None, key=None) -> None:
+        """largest_displacement over nodes first … first + count − 1, into _moved[0] (first half) or _moved[1]."""
+        count = self.model.node_count - first if count is None else count
+        self._launch(largest_displacement, count, [first, int(first > 0), state.x, self._x_build, self._moved],
+                     key=key)
 
     def _lanes(self, n: int) -> tuple[int, int]:
         """(threads, stride) of a launch over a list of at most n items whose length is on the device: one thread
@@ -389,7 +429,7 @@ class BlockContact:
     def _check_moved(self, state) -> None:
         """The displacement check: rebuild_due when a node has moved more than rebuild_skin since the build."""
         self._moved.zero_()
-        self._launch(largest_displacement, self.model.node_count, [state.x, self._x_build, self._moved])
+        self._halves("displacement", self.model.node_count, self._largest_displacement, state)
         self._launch(rebuild_decision, 1, [self._moved, self.rebuild_skin ** 2, self._rebuild_due, self._rebuilds])
 
     def _rebuild(self, state) -> None:

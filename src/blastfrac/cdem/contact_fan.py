@@ -214,6 +214,7 @@ def held_search(
 
 @wp.kernel
 def mark_pair_changes(
+    first: wp.int32,
     pair_mode: wp.array(dtype=wp.int32),
     pair_dropped: wp.array(dtype=wp.int32),
     pair_vertex: wp.array(dtype=wp.int32),
@@ -230,8 +231,12 @@ def mark_pair_changes(
 ):
     """List (once each, counts[0] of them) the vertices whose fan caches a change of spring p's state since the
     last call makes stale: both ends of p's interface (the exposure of its edges counts at both vertices, the
-    exclusion chains at p's own); and the sorted_code sign of the hash points on the interface's two edges."""
-    p = wp.tid()
+    exclusion chains at p's own); and the sorted_code sign of the hash points on the interface's two edges.
+
+    Springs first, first + 1, …: two threads may each take half of them (split at an interface), each with its own
+    list and count (append_vertices joins them in order). A vertex whose springs change in both halves may then be
+    listed twice (the two threads' stamps race); its caches are rebuilt twice, to the same values."""
+    p = first + wp.tid()
     step = clock[0]
     mode = pair_mode[p]
     dropped = pair_dropped[p]
@@ -252,6 +257,16 @@ def mark_pair_changes(
             rng = slot_samples[sl]
             for i in range(rng[0], rng[0] + rng[1]):
                 sorted_code[sample_pos[i]] = code
+
+
+@wp.kernel
+def append_vertices(counts: wp.array(dtype=wp.int32), dirty_vertices: wp.array(dtype=wp.int32),
+                    counts_b: wp.array(dtype=wp.int32), dirty_b: wp.array(dtype=wp.int32)):
+    """Append the second half's list of stale vertices (mark_pair_changes) to the first's, in order (one thread)."""
+    n = counts[0]
+    for i in range(counts_b[0]):
+        dirty_vertices[n + i] = dirty_b[i]
+    counts[0] = n + counts_b[0]
 
 
 @wp.func

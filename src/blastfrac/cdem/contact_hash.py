@@ -35,13 +35,14 @@ def compute_edge_samples(
 
 
 @wp.kernel
-def largest_displacement(x: wp.array(dtype=wp.vec2d), x_build: wp.array(dtype=wp.vec2d),
-                         moved: wp.array(dtype=wp.float64)):
-    """moved[0] = max over the nodes of |x − x_build|² [m²]: how far the hash points may have moved since the hash
-    was built (a point on an edge moves no more than the edge's nodes)."""
-    n = wp.tid()
+def largest_displacement(first: wp.int32, slot: wp.int32, x: wp.array(dtype=wp.vec2d),
+                         x_build: wp.array(dtype=wp.vec2d), moved: wp.array(dtype=wp.float64)):
+    """moved[slot] = max over the nodes first, first + 1, … of |x − x_build|² [m²]: how far the hash points may have
+    moved since the hash was built (a point on an edge moves no more than the edge's nodes). Two threads each take
+    half of the nodes and a slot of their own (rebuild_decision takes the larger): the maximum is exact either way."""
+    n = first + wp.tid()
     d = x[n] - x_build[n]
-    wp.atomic_max(moved, 0, wp.dot(d, d))
+    wp.atomic_max(moved, slot, wp.dot(d, d))
 
 
 @wp.kernel
@@ -71,9 +72,9 @@ def contact_tick(clock: wp.array(dtype=wp.int32), check_due: wp.array(dtype=wp.i
 @wp.kernel
 def rebuild_decision(moved: wp.array(dtype=wp.float64), skin2: wp.float64, rebuild_due: wp.array(dtype=wp.int32),
                      rebuilds: wp.array(dtype=wp.int32)):
-    """rebuild_due[0] = 1 when a node has moved more than the skin since the build (moved[0] > skin² [m²]), and
-    count the rebuild (one thread)."""
-    if moved[0] > skin2:
+    """rebuild_due[0] = 1 when a node has moved more than the skin since the build (max(moved[0], moved[1]) > skin²
+    [m²]), and count the rebuild (one thread)."""
+    if wp.max(moved[0], moved[1]) > skin2:
         rebuild_due[0] = 1
         rebuilds[0] = rebuilds[0] + 1
 

@@ -17,7 +17,9 @@ from .kernels_spring import launch_spring_forces, spring_model, spring_scalars, 
 #: per stage, the items from which two threads split it, in units of CDEMSolver.split_min interfaces: a stage is split
 #: where it costs more than ~0.5 ms (per item at 234k triangles on one core: 53 ns a spring interface, 15 ns a CST
 #: block, 4 ns a gathered node, 10 ns an integrated block; two hand-offs of ~85 µs must be paid for)
-SPLIT_SCALE = {"springs": 1, "blocks": 3, "gather": 12, "integrate": 5}
+#: block contact's scans over the whole rock: ~2 ns a spring for the changes' scan, ~7 ns a node for the displacement
+#: check (at 113k blocks, one core)
+SPLIT_SCALE = {"springs": 1, "blocks": 3, "gather": 12, "integrate": 5, "pair_changes": 20, "displacement": 5}
 
 
 class CDEMSolver:
@@ -45,6 +47,8 @@ class CDEMSolver:
         self.split_min = 10000
         self._split_ready: set = set()           # the stages whose module has loaded (the first call is serial)
         self._capturing = False
+        if self.contact is not None:
+            self.contact.in_halves = self._in_halves     # block contact's scans over the whole rock, likewise
         self.ppv_out: wp.array | None = None     # peak speed per node [m/s] the integration updates (Simulation sets
                                                  # it to its PeakVelocity array; not saved twice by a checkpoint)
         # the spring kernel's structs (kernels_spring.SpringModel, SpringState): one model, one per State
