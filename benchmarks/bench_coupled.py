@@ -6,7 +6,8 @@ For the demo (examples/circular_rock/demo.toml) and the confined example at P = 
 * per stage, at the intact start and at the cracked end state (``steps`` timed steps each, synchronised per
   stage): rock forces (springs, CST, loads, block contact), particle–edge contact, crack gas (when on), P2G and
   grid update, rock integration, G2P, burn and EOS, and the ``wp.launch`` calls per step;
-* the whole run again pinned to one core (``taskset -c 0``, in a subprocess) against both cores.
+* the whole run again pinned to one core (``taskset -c 0``, in a subprocess) against both cores;
+* the shipped confined P0 (113,690 blocks) over its first steps on one core and on two threads (``two_cores``).
 
 ``--reference DIR`` (run_reference) builds ``../shared/bench-reference`` in a scratch copy and runs its C++
 float64 CDEM and MPM loops on one thread beside blastfrac's CDEM and MPM benchmarks at the same sizes; the
@@ -161,6 +162,35 @@ def one_core_wall(name: str, device: str = "cpu") -> float | None:
         if line.startswith("WALL"):
             return float(line.split()[1])
     return None
+
+
+#: issue 14 item 3's problem: the confined example as shipped (113,690 blocks, 2.5 mm beyond the refinement zone)
+SHIPPED_P0 = "examples/confined_blast/scenario_P0.toml"
+
+
+def two_cores(steps: int = 1500, device: str = "cpu") -> dict | None:
+    """The shipped confined P0 over ``steps`` steps (after 20 untimed ones, outputs off), once pinned to one core
+    with ``simulation.threads = 1`` (taskset) and once on both cores with ``threads = 2``, each in a subprocess;
+    seconds per step and the speed-up. None without taskset or on a GPU."""
+    if shutil.which("taskset") is None or device != "cpu":
+        return None
+    code = ("import sys,time,tempfile; sys.path.insert(0, %r); import bench_coupled as b\n"
+            "with tempfile.TemporaryDirectory() as t:\n"
+            "    sim = b._sim(%r, ['simulation.threads=' + sys.argv[1]], 'cpu', t)\n"
+            "    [sim.step() for _ in range(20)]\n"
+            "    t0 = time.perf_counter()\n"
+            "    [sim.step() for _ in range(%d)]\n"
+            "    print('STEP', (time.perf_counter() - t0) / %d, sim.model.element_count)") % (
+        str(Path(__file__).parent), SHIPPED_P0, steps, steps)
+    out = {"steps": steps}
+    for key, pre, threads in (("one_core", ["taskset", "-c", "0"], "1"), ("two_threads", [], "2")):
+        r = subprocess.run([*pre, sys.executable, "-c", code, threads], capture_output=True, text=True)
+        line = [ln for ln in r.stdout.splitlines() if ln.startswith("STEP")]
+        if not line:
+            return None
+        out[key + "_s"], out["elements"] = float(line[0].split()[1]), int(line[0].split()[2])
+    out["speedup"] = out["one_core_s"] / out["two_threads_s"]
+    return out
 
 
 def markdown(rows: list[dict]) -> str:

@@ -16,6 +16,9 @@ def add_parser(sub) -> None:
                    help="one suite; default: cdem and mpm ('examples' runs the paper's examples at full resolution, "
                    "minutes; 'coupled' times the demo and confined P0 whole and per stage, intact and cracked, on 1 "
                    "and 2 cores)")
+    p.add_argument("--two-core-steps", type=int, default=1500, metavar="N",
+                   help="with --only coupled: time the shipped confined P0 over N steps on one core and on two "
+                        "threads (0: skip)")
     p.add_argument("--reference", default=None, metavar="DIR",
                    help="also build the C++ reference of DIR (../shared/bench-reference) in a scratch copy and run "
                         "its CDEM and MPM loops on one thread beside blastfrac's, as ratios per element-step")
@@ -78,6 +81,11 @@ def run(args) -> int:
         print(f"\nFixed cost of a step (the demo's step on {fx['tiny_size'][0]} elements and {fx['tiny_size'][1]} points, "
               f"one thread): {fx['tiny_ms']:.3f} ms, {100 * fx['fraction']:.0f} % of the demo's first steps "
               f"({fx['demo_ms']:.3f} ms); with two threads {fx['tiny_2threads_ms']:.3f} ms (their hand-offs)")
+        tc = cp.two_cores(args.two_core_steps, device) if args.two_core_steps > 0 else None
+        if tc is not None:
+            print(f"\nShipped confined P0 ({tc['elements']:,} blocks), {tc['steps']} steps after 20: one core "
+                  f"(threads = 1, taskset) {1e3 * tc['one_core_s']:.2f} ms/step, two threads "
+                  f"{1e3 * tc['two_threads_s']:.2f} ms/step: {tc['speedup']:.2f}x")
     if args.reference:
         cp = _load("bench_coupled")
         from pathlib import Path as _P
