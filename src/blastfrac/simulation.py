@@ -77,12 +77,16 @@ class Simulation:
             self._build_explosive()
         self.dt = self._time_step()
         self._pool = None
+        self._second = None
+        self._parallel = False                             # this step runs stage groups in two threads
         if scenario.simulation.threads > 1 and self.gas is not None and self.device == "cpu" and \
                 (os.cpu_count() or 1) > 1:
             from concurrent.futures import ThreadPoolExecutor
 
+            from .second_thread import SecondThread
+
             self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="blastfrac-gas")
-            self.cdem.pool = self._pool                    # the springs in two halves (CDEMSolver.forces_springs)
+            self._second = SecondThread()                  # whether a step uses it: timed (second_thread.py)
         self.time = 0.0
         self.steps = 0
         self.alpha = scenario.simulation.damping
@@ -198,6 +202,9 @@ class Simulation:
         dt = self.dt
         st = self.state
         couple = gas and self.gas is not None
+        if self._second is not None:                       # the second thread where it measured faster
+            self._parallel = couple and self._second.use(self.steps)
+            self.cdem.pool = self._pool if self._parallel else None
         if not couple and self.use_graph and self.cdem.step_captured(st, dt, self.time, self.alpha, self._rock_after):
             pass                                           # the rock step below, replayed from a captured graph
         elif couple:
@@ -235,9 +242,10 @@ class Simulation:
         self.gas.update_eos(dt, self.time)                 # burn, viscosity, JWL
 
     def _concurrently(self, rock, gas) -> None:
-        """Run the two stage groups, in the second thread when simulation.threads = 2 (from the second step on: the
-        first loads every kernel's module, which Warp does not guard against two threads)."""
-        if self._pool is None or self.steps == 0:
+        """Run the two stage groups, in the second thread when simulation.threads = 2 and this step uses it (never the
+        first step, which loads every kernel's module, which Warp does not guard against two threads; after it, where
+        timing the run's steps found it faster: second_thread.py)."""
+        if not self._parallel:
             rock()
             gas()
             return
@@ -623,6 +631,8 @@ class Simulation:
             from .analysis.symmetry import symmetry_report
 
             out["symmetry"] = symmetry_report(self.scenario)
+        if self._second is not None:
+            out["threads"] = self._second.report()
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
                                 "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}

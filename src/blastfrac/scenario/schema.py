@@ -41,9 +41,12 @@ class SimulationConfig(_Strict):
         2, ge=1, le=2, description="CPU threads of a coupled step [-]: 2 runs the gas stages (particle–edge "
         "contact, crack gas, P2G, grid, G2P, EOS) beside the rock's (CST, loads, block contact, integration) in a "
         "second Python thread (Warp's CPU kernels release the GIL), and the springs in two halves; the motion and "
-        "fracture are the same as with 1, the energy books to round-off (tests/unit/test_threads.py). Default 2: with recorded launches, 1.14x on the demo and 1.16x on confined P0 on 2 idle "
-        "cores, the same with the other core busy (benchmarks/RESULTS.md). One thread on a 1-core machine or a GPU; "
-        "a sweep runs each case with 1 (its cases fill the cores).",
+        "fracture are the same as with 1, the energy books too (tests/unit/test_threads.py). With 2 the run times its "
+        "own steps on one thread and on two in short trials and uses the second thread only where it measured "
+        "faster, tried again every 2000 steps (blastfrac/second_thread.py; summary.json → threads): the shipped "
+        "confined P0 ran 1.5x faster on two, the demo 10-20 % slower before this choice, the same with it "
+        "(benchmarks/RESULTS.md). One thread on a 1-core machine or a GPU; a sweep runs each case with 1 (its cases "
+        "fill the cores).",
     )
 
 
