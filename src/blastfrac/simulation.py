@@ -209,12 +209,16 @@ class Simulation:
             pass                                           # the rock step below, replayed from a captured graph
         elif couple:
             self.cdem.forces_springs(st, dt, self.time)    # springs + failure (sets this step's pair_mode)
-            self._concurrently(lambda: self.cdem.forces_rest(st, dt, self.time), lambda: self._gas_forces(dt))
+            # the rock's rest, and the gas's forces beside it in the second thread (handed over where it is free)
+            self.cdem.forces_rest(st, dt, self.time, beside=lambda: self._gas_forces(dt))
             self.coupler.add_reactions(st)                 # the gas loads on the rock, in a fixed order
             if self.crack_gas is not None:
                 self.crack_gas.add_loads(st)
-            self._concurrently(lambda: self.cdem.integrate(st, dt, self.alpha),
-                               lambda: self._gas_advance(dt))
+            if self.cdem.splits("integrate", self.model.element_count):
+                self.cdem.integrate(st, dt, self.alpha)     # in two halves: the second thread is taken
+                self._gas_advance(dt)
+            else:
+                self._concurrently(lambda: self.cdem.integrate(st, dt, self.alpha), lambda: self._gas_advance(dt))
         else:
             self.cdem.forces_springs(st, dt, self.time)    # springs + failure
             self.cdem.forces_rest(st, dt, self.time)       # CST, loads, block contact

@@ -333,8 +333,11 @@ class BlockContact:
             self._prm_values = values
         return self.s_prm
 
-    def apply(self, state, dt: float) -> None:
+    def apply(self, state, dt: float, hand_over=None) -> None:
         """Add the contact forces of the current configuration to state.f; dt [s] drives the friction.
+        ``hand_over``: called once the scans over the whole rock (which two threads may split) are done, before the
+        cache refresh and the passes over this step's lists (CDEMSolver.forces_rest hands another stage group to the
+        second thread there).
 
         Nothing is read back to the host, so the pass can be captured in a graph (CDEMSolver.step_captured): the
         schedule (step count, hash check and rebuild) lives on the device (``contact_tick``) and its branches run
@@ -362,6 +365,9 @@ class BlockContact:
                     self._launch(append_vertices, 1, [self._counts, self._dirty_vertices, self._counts_b,
                                                       self._dirty_b])
                     self._b_listed = False
+        if hand_over is not None:
+            hand_over()
+        if use_cache:
             if not self._cache_fresh:
                 self._refresh(state, 1)
             else:
@@ -402,7 +408,7 @@ class BlockContact:
                       self.seen_dropped, self.vertex_stamp, self._counts_b if second else self._counts,
                       self._dirty_b if second else self._dirty_vertices, self.iface_slots, self.slot_samples,
                       self.sample_pos, self.sorted_code], key=key)
-        self._b_listed = self._b_listed or second        # joined by _join_halves once both halves have run
+        self._b_listed = self._b_listed or second        # joined by append_vertices once both halves have run
 
     def _largest_displacement(self, state, first: int = 0, count: int | None = None, key=None) -> None:
         """largest_displacement over nodes first … first + count − 1, into _moved[0] (first half) or _moved[1]."""

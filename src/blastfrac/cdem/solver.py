@@ -105,8 +105,7 @@ class CDEMSolver:
         pool's thread, where there is a pool (two threads), n ≥ SPLIT_SCALE[stage]·split_min, the device is a CPU,
         no graph is being captured and the stage has run once (its first call loads its module, which Warp does not
         guard against two threads); else in one launch."""
-        if self.pool is None or n < SPLIT_SCALE[stage] * self.split_min or self.model.device != "cpu" or \
-                self._capturing or stage not in self._split_ready:
+        if not self.splits(stage, n):
             if self.pool is not None:
                 self._split_ready.add(stage)
             launch(*args, **kwargs)
@@ -118,15 +117,42 @@ class CDEMSolver:
         finally:
             fut.result()
 
-    def forces_rest(self, state: State, dt: float, t: float) -> None:
-        """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode)."""
+    def splits(self, stage: str, n: int) -> bool:
+        """True when ``_in_halves`` runs ``stage`` over n items in two threads (see there)."""
+        return not (self.pool is None or n < SPLIT_SCALE[stage] * self.split_min or self.model.device != "cpu" or
+                    self._capturing or stage not in self._split_ready)
+
+    def forces_rest(self, state: State, dt: float, t: float, beside=None) -> None:
+        """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode).
+
+        ``beside``: a stage group independent of these (the gas's forces) to run in the pool's thread meanwhile. It is
+        handed over where the pool is free for it: at once when the CST blocks run in one launch, else after the last
+        of the stages that run in two halves (CST, gather, and block contact's whole-rock scans), so that it overlaps
+        block contact's serial rest instead of holding up a half (the shipped confined P0: the rock's rest 8.5 ms
+        with the gas handed over first, the CST's second half waiting behind it). Without a pool it runs here, last."""
         m = self.model
-        self._in_halves("blocks", m.element_count, launch_element_forces, m, state, dt, self.launch)   # 3b CST, f = f_int
-        self._in_halves("gather", m.node_count, launch_gather_springs, m, state, self.launch)  # 3c f += spring forces
-        self.set_pulses(state, t)
-        launch_edge_loads(self.model, state, self.dt_prev, self.launch)       # 3d pressure pulses, in-situ tractions
-        if self.contact is not None:
-            self.contact.apply(state, dt)                         # 3e node-to-edge block contact
+        fut = []
+
+        def hand_over() -> None:
+            if beside is not None and not fut:
+                fut.append(self.pool.submit(beside))
+
+        try:
+            if beside is not None and self.pool is not None and not self.splits("blocks", m.element_count):
+                hand_over()
+            self._in_halves("blocks", m.element_count, launch_element_forces, m, state, dt, self.launch)  # 3b CST
+            self._in_halves("gather", m.node_count, launch_gather_springs, m, state, self.launch)  # 3c f += springs
+            self.set_pulses(state, t)
+            launch_edge_loads(self.model, state, self.dt_prev, self.launch)   # 3d pressure pulses, in-situ tractions
+            if self.contact is not None:                          # 3e node-to-edge block contact
+                self.contact.apply(state, dt, hand_over=hand_over if self.pool is not None else None)
+            if self.pool is not None:
+                hand_over()
+        finally:
+            if fut:
+                fut[0].result()
+        if beside is not None and self.pool is None:
+            beside()
 
     def integrate(self, state: State, dt: float, alpha: float = 0.0) -> None:
         """Stage 4: central difference with damping, constraints and dashpots (and the PPV, if ``ppv_out`` is set)."""
