@@ -8,8 +8,8 @@ model (the shipped confined P0, 113,690 blocks: 1.5× faster) and costs on a sma
 2.5 ms a step on one thread, 2.8–3.1 ms on two; benchmarks/RESULTS.md, stop 26).
 
 :class:`SecondThread` therefore times the run's steps in trial windows, alternating one thread and two
-(``WINDOW`` steps each, ``WINDOWS`` windows, starting with one thread), takes the mode whose median step time is
-lower, holds it for ``RETUNE`` steps (the step's cost changes as the rock cracks) and then tries again. A step's
+(``WINDOW`` steps each, ``WINDOWS`` windows, starting with one thread: 16 steps of each), takes the mode whose
+median step time is lower, holds it for ``RETUNE`` steps (the step's cost changes as the rock cracks) and then tries again. A step's
 time is the wall time from its start to the next step's start, so the run loop's sampling and output fall into it;
 the median keeps an occasional sampling step from deciding.
 """
@@ -24,7 +24,7 @@ class SecondThread:
     """The trial schedule and the choice; ``use(step)`` is called at the start of every step."""
 
     WINDOW = 8          #: steps in one trial window
-    WINDOWS = 8         #: windows in one trial, alternating one thread / two
+    WINDOWS = 4         #: windows in one trial, alternating one thread / two
     RETUNE = 2000       #: steps between the end of a trial and the start of the next
 
     def __init__(self, clock=time.perf_counter):

@@ -208,9 +208,9 @@ class Simulation:
         if not couple and self.use_graph and self.cdem.step_captured(st, dt, self.time, self.alpha, self._rock_after):
             pass                                           # the rock step below, replayed from a captured graph
         elif couple:
-            self.cdem.forces_springs(st, dt, self.time)    # springs + failure (sets this step's pair_mode)
+            self.cdem.forces_springs_blocks(st, dt, self.time)   # springs + failure (this step's pair_mode), CST
             # the rock's rest, and the gas's forces beside it in the second thread (handed over where it is free)
-            self.cdem.forces_rest(st, dt, self.time, beside=lambda: self._gas_forces(dt))
+            self.cdem.forces_rest(st, dt, self.time, beside=lambda: self._gas_forces(dt), blocks_done=True)
             self.coupler.add_reactions(st)                 # the gas loads on the rock, in a fixed order
             if self.crack_gas is not None:
                 self.crack_gas.add_loads(st)

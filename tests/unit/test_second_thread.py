@@ -55,7 +55,7 @@ def test_the_choice_is_tried_again_when_the_step_changes():
     span = sel.WINDOW * sel.WINDOWS
     # two threads pay on the intact rock of the first steps and cost once it has cracked (step ≥ 200)
     cost = lambda k, m: (1.0 if m else 1.5) if k < 200 else (2.0 if m else 1.0)   # noqa: E731
-    modes = _run(sel, clock, 560, cost)            # the last steps between trials (the fifth starts at 571)
+    modes = _run(sel, clock, 560, cost)            # ends between two trials (one starts at 575 with WINDOWS = 4)
     assert sel.trials[0]["chose"] == 2 and sel.trials[-1]["chose"] == 1
     assert modes[1 + span] is True and modes[-1] is False
     assert sel.steps == 560 and 0 < sel.steps_parallel < 560
