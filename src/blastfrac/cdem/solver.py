@@ -152,8 +152,9 @@ class CDEMSolver:
         """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode).
 
         ``beside``: a stage group independent of these (the gas's forces) to run in the pool's thread meanwhile. It is
-        handed over where the pool is free for it: at once when the CST blocks run in one launch, else after the last
-        of the stages that run in two halves (CST, gather, and block contact's whole-rock scans), so that it overlaps
+        handed over where the pool is free for it: at once when the group's first stage (the CST blocks, or the gather
+        with ``blocks_done``) runs in one launch, else after the last of the stages that run in two halves (CST,
+        gather, and block contact's whole-rock scans), so that it overlaps
         block contact's serial rest instead of holding up a half (the shipped confined P0: the rock's rest 8.5 ms
         with the gas handed over first, the CST's second half waiting behind it). Without a pool it runs here, last.
         ``blocks_done``: 3b ran already (``forces_springs_blocks``)."""

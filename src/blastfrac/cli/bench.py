@@ -80,7 +80,8 @@ def run(args) -> int:
         fx = cp.fixed_cost(device)
         print(f"\nFixed cost of a step (the demo's step on {fx['tiny_size'][0]} elements and {fx['tiny_size'][1]} points, "
               f"one thread): {fx['tiny_ms']:.3f} ms, {100 * fx['fraction']:.0f} % of the demo's first steps "
-              f"({fx['demo_ms']:.3f} ms); with two threads {fx['tiny_2threads_ms']:.3f} ms (their hand-offs)")
+              f"({fx['demo_ms']:.3f} ms); with threads = 2 {fx['tiny_2threads_ms']:.3f} ms (a step uses the second "
+              f"thread only where the run's trial measured it faster)")
         tc = cp.two_cores(args.two_core_steps, device) if args.two_core_steps > 0 else None
         if tc is not None:
             print(f"\nShipped confined P0 ({tc['elements']:,} blocks), {tc['steps']} steps after 20: one core "
