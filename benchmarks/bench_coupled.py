@@ -180,7 +180,8 @@ def two_cores(steps: int = 1500, device: str = "cpu") -> dict | None:
             "    [sim.step() for _ in range(20)]\n"
             "    t0 = time.perf_counter()\n"
             "    [sim.step() for _ in range(%d)]\n"
-            "    print('STEP', (time.perf_counter() - t0) / %d, sim.model.element_count)") % (
+            "    print('STEP', (time.perf_counter() - t0) / %d, sim.model.element_count)\n"
+            "    print('CHOSE', *[t['chose'] for t in (sim._second.report()['trials'] if sim._second else [])])") % (
         str(Path(__file__).parent), SHIPPED_P0, steps, steps)
     out = {"steps": steps}
     for key, pre, threads in (("one_core", ["taskset", "-c", "0"], "1"), ("two_threads", [], "2")):
@@ -189,6 +190,9 @@ def two_cores(steps: int = 1500, device: str = "cpu") -> dict | None:
         if not line:
             return None
         out[key + "_s"], out["elements"] = float(line[0].split()[1]), int(line[0].split()[2])
+        if threads == "2":                   # the threads each of the run's trials chose (second_thread.py)
+            chose = [ln for ln in r.stdout.splitlines() if ln.startswith("CHOSE")]
+            out["trials_chose"] = [int(c) for c in chose[0].split()[1:]] if chose else []
     out["speedup"] = out["one_core_s"] / out["two_threads_s"]
     return out
 

@@ -86,7 +86,8 @@ def run(args) -> int:
         if tc is not None:
             print(f"\nShipped confined P0 ({tc['elements']:,} blocks), {tc['steps']} steps after 20: one core "
                   f"(threads = 1, taskset) {1e3 * tc['one_core_s']:.2f} ms/step, two threads "
-                  f"{1e3 * tc['two_threads_s']:.2f} ms/step: {tc['speedup']:.2f}x")
+                  f"{1e3 * tc['two_threads_s']:.2f} ms/step: {tc['speedup']:.2f}x (threads chosen by the two-thread "
+                  f"run's trials: {tc.get('trials_chose')})")
     if args.reference:
         cp = _load("bench_coupled")
         from pathlib import Path as _P
