@@ -233,9 +233,10 @@ def mark_pair_changes(
     last call makes stale: both ends of p's interface (the exposure of its edges counts at both vertices, the
     exclusion chains at p's own); and the sorted_code sign of the hash points on the interface's two edges.
 
-    Springs first, first + 1, …: two threads may each take half of them (split at an interface), each with its own
-    list and count (append_vertices joins them in order). A vertex whose springs change in both halves may then be
-    listed twice (the two threads' stamps race); its caches are rebuilt twice, to the same values."""
+    Springs first, first + 1, …: two threads may each take half of them, each with its own list and count
+    (append_vertices joins them in order). A vertex whose springs change in both halves may then be listed twice
+    (the two threads' stamps race); its caches are rebuilt twice, to the same values. Where the split falls between
+    the two springs of one interface, both threads write that interface's sorted_code, and write the same value."""
     p = first + wp.tid()
     step = clock[0]
     mode = pair_mode[p]
