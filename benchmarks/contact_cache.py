@@ -27,7 +27,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 STATE_ARRAYS = ("x", "v", "f", "sigma", "pair_F", "pair_force", "pair_str", "pair_mode", "pair_dropped", "pair_g0",
-                "pair_tbreak", "pair_work", "pair_efrac", "pair_damp", "elem_damp", "elem_absorbed", "ledge_fprev",
+                "pair_tbreak", "pair_inelastic", "pair_efrac", "pair_damp", "elem_damp", "elem_absorbed", "ledge_fprev",
                 "pulse_values",
                 "energy_acc")
 CONTACT_ARRAYS = ("contact_slot", "contact_fs", "contact_d0", "contact_p", "contact_kc", "elem_near", "query_after",

@@ -14,7 +14,7 @@ import pytest
 from blastfrac.simulation import Simulation
 from conftest import scenario
 
-STATE = ("x", "v", "f", "sigma", "pair_F", "pair_mode", "pair_dropped", "pair_tbreak", "pair_work", "pair_damp",
+STATE = ("x", "v", "f", "sigma", "pair_F", "pair_mode", "pair_dropped", "pair_tbreak", "pair_inelastic", "pair_damp",
          "elem_damp", "elem_absorbed", "energy_acc")
 
 

@@ -35,12 +35,12 @@ def rock_energies(model, state) -> dict[str, float]:
     kn, ks = model.host["pair_kn"], model.host["pair_ks"]
     stored = 0.5 * F[:, 0] ** 2 / kn + 0.5 * F[:, 1] ** 2 / ks
     mode = state.pair_mode.numpy()
-    work = state.pair_work.numpy()
+    inelastic = state.pair_inelastic.numpy()            # work done on each spring beyond its stored energy
     efrac = state.pair_efrac.numpy()
     broken = mode > 0
     acc = state.energy_acc.numpy()
-    fracture = float(efrac[broken].sum() + np.sum((work - stored)[~broken]))
-    friction = float(np.sum((work - stored - efrac)[broken])) + float(acc[CONTACT_DISSIPATED])
+    fracture = float(efrac[broken].sum() + np.sum(inelastic[~broken]))
+    friction = float(np.sum((inelastic - efrac)[broken])) + float(acc[CONTACT_DISSIPATED])
     with np.errstate(over="ignore", invalid="ignore"):   # a blown-up state: the NaN guard reports where
         strain = float(np.sum(strain_energy_density(sig, model.lam, model.mu) * area))
     return {

@@ -64,9 +64,10 @@ def eval_element_forces(
     area = wp.float64(0.5) * wp.abs(two_a)
     trD = grad_v[0, 0] + grad_v[1, 1]
     q = bulk_viscosity(trD, rho, wp.sqrt(area), c_p, q_quad, q_lin)
-    if q > wp.float64(0.0):
-        s = wp.vec3d(s[0] - q, s[1] - q, s[2])
-        elem_damp[e] = elem_damp[e] - q * trD * area * dt
+    # with q = 0 (expansion, or no viscosity) both lines leave their values as they are, bit for bit; written
+    # without a branch on q > 0, which the CPU mispredicts in a wave field (materials/artificial_viscosity.py)
+    s = wp.vec3d(s[0] - q, s[1] - q, s[2])
+    elem_damp[e] = elem_damp[e] - q * trD * area * dt
     h = wp.float64(-0.5)
     f[n0] = h * wp.vec2d(s[0] * g0[0] + s[2] * g0[1], s[2] * g0[0] + s[1] * g0[1])
     f[n0 + 1] = h * wp.vec2d(s[0] * g1[0] + s[2] * g1[1], s[2] * g1[0] + s[1] * g1[1])

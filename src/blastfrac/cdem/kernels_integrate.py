@@ -75,16 +75,14 @@ def store_block(v: wp.array(dtype=wp.vec2d), x: wp.array(dtype=wp.vec2d), n0: in
 
 @wp.func
 def peak_speed(ppv: wp.array(dtype=wp.float64), n0: int, w0: wp.vec2d, w1: wp.vec2d, w2: wp.vec2d):
-    """ppv[n] = max(ppv[n], |w|) for the block's nodes n0 … n0+2 [m/s] (the PPV of analysis/ppv.py)."""
-    s0 = wp.length(w0)
-    if s0 > ppv[n0]:
-        ppv[n0] = s0
-    s1 = wp.length(w1)
-    if s1 > ppv[n0 + 1]:
-        ppv[n0 + 1] = s1
-    s2 = wp.length(w2)
-    if s2 > ppv[n0 + 2]:
-        ppv[n0 + 2] = s2
+    """ppv[n] = max(ppv[n], |w|) for the block's nodes n0 … n0+2 [m/s] (the PPV of analysis/ppv.py).
+
+    Written every step without a branch: while a wave spreads, whether a node's speed has grown is a coin toss
+    the CPU cannot predict, and the branch that skipped the write cost more than the write (the shipped confined
+    P0 at 1500 steps: the integration 5.5 ms with the branch, 2.6 without; 1.8 with no PPV)."""
+    ppv[n0] = wp.max(ppv[n0], wp.length(w0))
+    ppv[n0 + 1] = wp.max(ppv[n0 + 1], wp.length(w1))
+    ppv[n0 + 2] = wp.max(ppv[n0 + 2], wp.length(w2))
 
 
 @wp.kernel

@@ -23,16 +23,28 @@ def stored_spring_energy(fn: wp.float64, fs: wp.float64, kn: wp.float64, ks: wp.
     return half * fn * fn / kn + half * fs * fs / ks
 
 
+@wp.func
+def inelastic_work(f0: wp.vec2d, fn: wp.float64, fs: wp.float64, dn: wp.float64, ds: wp.float64,
+                   kn: wp.float64, ks: wp.float64):
+    """Work done on a spring over an increment beyond the change of its stored energy [J/m]: the trapezoidal work
+    −½(Fn0 + Fn)·Δd_n − ½(Fs0 + Fs)·Δd_s minus (stored(Fn, Fs) − stored(Fn0, Fs0)). Zero, up to round-off, for an
+    elastic increment (Fn = Fn0 − Kn·Δd_n, Fs = Fs0 − Ks·Δd_s)."""
+    half = wp.float64(0.5)
+    w = -half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
+    return w - (stored_spring_energy(fn, fs, kn, ks) - stored_spring_energy(f0[0], f0[1], kn, ks))
+
+
 @wp.struct
 class SpringModel:
     """The springs' fixed data (cdem/kernels_spring.py): the nodes of each pair, per interface the stiffness Kn, Ks
-    [N/m per m], area A_c [m] and rest length L0 [m] of each of its two pairs, per pair the dashpot roots
-    (√(m_eff·Kn), √(m_eff·Ks)) and the law (tanφ, tanφ_r, slope_t, slope_c), and the model's scalars."""
+    [N/m per m], area A_c [m] and rest length L0 [m] of each of its two pairs and the law (tanφ, tanφ_r, slope_t,
+    slope_c; read when per_pair_law = 1), per pair the dashpot roots (√(m_eff·Kn), √(m_eff·Ks)), and the model's
+    scalars."""
 
     pair_i: wp.array(dtype=wp.int32)
     pair_j: wp.array(dtype=wp.int32)
     spring: wp.array(dtype=wp.vec4d)            # per interface: Kn, Ks, A_c, L0 (both pairs alike)
-    law: wp.array(dtype=wp.vec4d)
+    law: wp.array(dtype=wp.vec4d)              # per interface (Model.iface_law)
     dashpot: wp.array(dtype=wp.vec2d)           # per pair: √(m_eff·Kn), √(m_eff·Ks) [kg/s per m]
     tan_phi: wp.float64
     tan_phi_r: wp.float64
@@ -47,7 +59,8 @@ class SpringModel:
 @wp.struct
 class SpringState:
     """Each spring's state (a State's pair_* arrays): force (Fn, Fs) [N/m], strengths, mode, dropped, gap at
-    break g0 [m], break time [s], work, fracture energy and dashpot work [J/m], and the force on its j node [N/m]."""
+    break g0 [m], break time [s], work beyond the stored energy (pair_inelastic), fracture energy and dashpot work
+    [J/m], and the force on its j node [N/m]."""
 
     F: wp.array(dtype=wp.vec2d)
     strength: wp.array(dtype=wp.vec2d)
@@ -55,7 +68,7 @@ class SpringState:
     dropped: wp.array(dtype=wp.int32)
     g0: wp.array(dtype=wp.float64)
     tbreak: wp.array(dtype=wp.float64)
-    work: wp.array(dtype=wp.float64)
+    inelastic: wp.array(dtype=wp.float64)
     efrac: wp.array(dtype=wp.float64)
     damp: wp.array(dtype=wp.float64)
     force: wp.array(dtype=wp.vec2d)
@@ -67,7 +80,7 @@ def spring_model(model, sm: SpringModel | None = None) -> SpringModel:
     if sm is None:
         sm = SpringModel()
         sm.pair_i, sm.pair_j, sm.spring = model.pair_i, model.pair_j, model.iface_spring
-        sm.law, sm.dashpot = model.pair_law, model.pair_dashpot
+        sm.law, sm.dashpot = model.iface_law, model.pair_dashpot
     sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c = model.tan_phi, model.tan_phi_r, model.slope_t, model.slope_c
     sm.zeta, sm.per_pair_law, sm.breakable = model.spring_damping, int(model.per_pair_law), int(model.breakable)
     sm.crush = model.crush
@@ -84,7 +97,7 @@ def spring_state(state) -> SpringState:
     """The SpringState of a State (the same arrays)."""
     ss = SpringState()
     ss.F, ss.strength, ss.mode, ss.dropped = state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped
-    ss.g0, ss.tbreak, ss.work, ss.efrac, ss.force = (state.pair_g0, state.pair_tbreak, state.pair_work,
+    ss.g0, ss.tbreak, ss.inelastic, ss.efrac, ss.force = (state.pair_g0, state.pair_tbreak, state.pair_inelastic,
                                                     state.pair_efrac, state.pair_force)
     ss.damp = state.pair_damp
     return ss
@@ -107,8 +120,12 @@ def eval_spring_forces(
     enters the failure criteria, and its work goes to the pair's own dashpot account ss.damp (no two threads
     write one address, so the launch can be split or run on a GPU without atomics on a shared total).
 
-    With per_pair_law = 1 (a model with joints) each spring takes its friction and softening
-    (tanφ, tanφ_r, slope_t, slope_c) from pair_law; otherwise every spring takes the scalars.
+    With per_pair_law = 1 (a model with joints or a fracture band) each interface takes its friction and softening
+    (tanφ, tanφ_r, slope_t, slope_c) from iface_law; otherwise every spring takes the scalars.
+
+    Bytes per interface are what this kernel costs (it is the largest of the step): the law is read once per
+    interface, ``dropped`` only for a broken pair, and the work account (pair_inelastic, the work beyond the stored
+    energy) only where the increment was not elastic.
 
     Thread i updates interface first + i (a launch may cover part of the interfaces: two threads, see
     CDEMSolver.forces_springs).
@@ -132,11 +149,15 @@ def eval_spring_forces(
     t = wp.normalize(half * (xib + x[jb]) - half * (xia + x[ja]))
     n = wp.vec2d(t[1], -t[0])
     law = wp.vec4d(sm.tan_phi, sm.tan_phi_r, sm.slope_t, sm.slope_c)
+    if sm.per_pair_law != 0:
+        law = sm.law[q]
     for s in range(2):
         k = pa + s
-        if ss.dropped[k] != 0:
-            ss.force[k] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
-            continue
+        mode = ss.mode[k]
+        if mode != 0:                                   # only a broken pair can have been dropped
+            if ss.dropped[k] != 0:
+                ss.force[k] = wp.vec2d(wp.float64(0.0), wp.float64(0.0))
+                continue
         i = ia
         j = ja
         if s == 1:
@@ -151,9 +172,6 @@ def eval_spring_forces(
         f0 = ss.F[k]
         fn = wp.float64(0.0)
         fs = wp.float64(0.0)
-        if sm.per_pair_law != 0:
-            law = sm.law[k]
-        mode = ss.mode[k]
         if mode == 0:
             st = ss.strength[k]
             r = spring_update_intact(f0[0], f0[1], st[0], st[1], dn, ds, kn, ks, ac,
@@ -163,12 +181,15 @@ def eval_spring_forces(
             if r[2] != st[0] or r[3] != st[1]:           # softening or broken: most springs keep their strength
                 ss.strength[k] = wp.vec2d(r[2], r[3])
             new_mode = wp.int32(r[4])
-            w = ss.work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
-            ss.work[k] = w
-            if new_mode != 0:
-                ss.mode[k] = new_mode
-                ss.tbreak[k] = clock[0]
-                ss.efrac[k] = w - stored_spring_energy(fn, fs, kn, ks)
+            # an elastic increment (the trial forces kept) does work equal to its change of stored energy, so
+            # pair_inelastic (work − stored) stays as it is: most springs neither read nor write it
+            if new_mode != 0 or fn != f0[0] - kn * dn or fs != f0[1] - ks * ds:
+                w = ss.inelastic[k] + inelastic_work(f0, fn, fs, dn, ds, kn, ks)
+                ss.inelastic[k] = w
+                if new_mode != 0:
+                    ss.mode[k] = new_mode
+                    ss.tbreak[k] = clock[0]
+                    ss.efrac[k] = w
         else:
             # frame of a broken pair: the e1 face (node-to-face contact of j against the edge i_a→i_b of e1).
             # The midpoint frame is meaningless once the other pair has opened or the blocks have turned.
@@ -188,7 +209,7 @@ def eval_spring_forces(
                 r2 = spring_update_broken(f0[1], gap, g0, ds, kn, ks, law[1])
                 fn = r2[0]
                 fs = r2[1]
-            ss.work[k] = ss.work[k] - half * ((f0[0] + fn) * dn + (f0[1] + fs) * ds)
+            ss.inelastic[k] = ss.inelastic[k] + inelastic_work(f0, fn, fs, dn, ds, kn, ks)
         ss.F[k] = wp.vec2d(fn, fs)
         fv = fn * nn + fs * tt
         if sm.zeta > wp.float64(0.0) and (mode == 0 or fn > wp.float64(0.0)):

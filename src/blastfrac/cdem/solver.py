@@ -241,20 +241,17 @@ class CDEMSolver:
         fs = -np.einsum("ij,ij->i", tan, traction) * ac
         state.pair_F.assign(np.stack([fn, fs], 1))
         state.pair_g0.assign(fn / m.host["pair_kn"])
-        # the springs start loaded: book their stored energy as work done on them, so that work − stored (the
-        # fracture energy of an intact spring, analysis/energy.py) starts at 0
-        state.pair_work.assign(0.5 * fn**2 / m.host["pair_kn"] + 0.5 * fs**2 / m.host["pair_ks"])
+        # the springs start loaded: their stored energy is work done on them, so work − stored (pair_inelastic,
+        # the fracture energy of an intact spring, analysis/energy.py) starts at 0
+        state.pair_inelastic.zero_()
 
     def rebase_spring_work(self, state: State) -> float:
-        """Start the spring energy books of a new stage [J/m]: each intact spring's work becomes its stored
-        energy and each broken one's its stored energy plus its fracture energy (no fracture or friction
-        carried over), and return the fracture energy of the springs already broken, which the stage's
+        """Start the spring energy books of a new stage [J/m]: each intact spring's work beyond its stored energy
+        (pair_inelastic) becomes 0 and each broken one's its fracture energy (no fracture or friction carried over),
+        and return the fracture energy of the springs already broken, which the stage's
         budget must count as supplied (it stays in ``pair_efrac`` and in the fracture term)."""
-        m = self.model
-        F = state.pair_F.numpy()
-        stored = 0.5 * F[:, 0] ** 2 / m.host["pair_kn"] + 0.5 * F[:, 1] ** 2 / m.host["pair_ks"]
         broken = state.pair_mode.numpy() > 0
         efrac = state.pair_efrac.numpy()
-        state.pair_work.assign(stored + np.where(broken, efrac, 0.0))
+        state.pair_inelastic.assign(np.where(broken, efrac, 0.0))
         return float(efrac[broken].sum())
 

@@ -276,8 +276,8 @@ class ModelBuilder:
             pair_c0=arr(h["pair_c0"], wp.float64),
             iface_spring=arr(iface_spring(h), wp.vec4d),
             pair_dashpot=arr(pair_dashpot(h, self.topology.pair_nodes), wp.vec2d),
-            # per-spring (tanφ, tanφ_r, softening slopes) only with joints; the scalars above otherwise
-            pair_law=arr(h["pair_law"] if "pair_law" in h else np.zeros((1, 4)), wp.vec4d),
+            # per-interface (tanφ, tanφ_r, softening slopes) only with joints or a fracture band; the scalars otherwise
+            iface_law=arr(iface_law(h) if "pair_law" in h else np.zeros((1, 4)), wp.vec4d),
             per_pair_law=1 if "pair_law" in h else 0,
             ledge_n0=arr(h["ledge_n0"].astype(np.int32), wp.int32),
             ledge_n1=arr(h["ledge_n1"].astype(np.int32), wp.int32),
@@ -308,6 +308,15 @@ def iface_spring(h: dict) -> np.ndarray:
         if not np.array_equal(c[0::2], c[1::2]):
             raise AssertionError("the two pairs of an interface must share Kn, Ks, Ac and L0")
     return np.stack([c[0::2] for c in cols], 1) if len(cols[0]) else np.zeros((0, 4))
+
+
+def iface_law(h: dict) -> np.ndarray:
+    """(tanφ, tanφ_r, slope_t, slope_c) per interface [Q, 4] from host["pair_law"], which gives both pairs of an
+    interface the same law (the spring kernel reads it once per interface: half the bytes of a per-pair read)."""
+    law = h["pair_law"]
+    if not np.array_equal(law[0::2], law[1::2]):
+        raise AssertionError("the two pairs of an interface must share their friction and softening law")
+    return np.ascontiguousarray(law[0::2])
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -34,8 +34,9 @@ class Model:
         coefficients 2ζ√(m_eff K) without 2ζ (materials.interface.spring_dashpot), [2Q] vec2d
     pair_l0: length of the edge the spring belongs to [m], [P]
     pair_t0, pair_c0: initial tensile strength and cohesion [Pa], [P]
-    pair_law: per-spring (tanφ, tanφ_r, slope_t, slope_c), [P] vec4d, read only when per_pair_law = 1 (a model
-        with joints, geometry.joints); otherwise a 1-element placeholder and the scalars tan_phi.. slope_c apply
+    iface_law: per-interface (tanφ, tanφ_r, slope_t, slope_c), shared by its two pairs, [Q] vec4d, read only when
+        per_pair_law = 1 (a model with joints, geometry.joints, or a fracture band, rock.fracture_band_width);
+        otherwise a 1-element placeholder and the scalars tan_phi.. slope_c apply. host["pair_law"] holds it per pair
     host["pair_joint"]: joint set of each spring (−1 rock), [P]; host["pair_mode0"]: initial pair_mode (open joints)
     crush: compressive cap of the springs σ_cr [Pa] (rock.crushing_strength), 0 for none; one scalar for all springs
     spring_damping: dashpot ratio ζ beside every loaded spring [-] (materials.interface.spring_dashpot)
@@ -86,7 +87,7 @@ class Model:
     host: dict = field(default_factory=dict)
     mass_theta: float = 0.0   # consistent-mass fraction θ of the block mass matrices (cdem/kernels_integrate.py)
     elastic: object = None    # model.compliance.ElasticReport: input, block and assembly moduli
-    pair_law: wp.array = None  # per-spring friction and softening (joints); see the class docstring
+    iface_law: wp.array = None  # per-interface friction and softening (joints, fracture band); see the class docstring
     per_pair_law: int = 0
 
     @property
@@ -130,7 +131,7 @@ class Model:
             pair_dropped=wp.zeros(p, dtype=wp.int32, device=d),
             pair_g0=wp.zeros(p, dtype=wp.float64, device=d),
             pair_tbreak=wp.full(p, -1.0, dtype=wp.float64, device=d),
-            pair_work=wp.zeros(p, dtype=wp.float64, device=d),
+            pair_inelastic=wp.zeros(p, dtype=wp.float64, device=d),
             pair_efrac=wp.zeros(p, dtype=wp.float64, device=d),
             pair_damp=wp.zeros(p, dtype=wp.float64, device=d),
             elem_damp=wp.zeros(e, dtype=wp.float64, device=d),
@@ -166,7 +167,9 @@ class State:
     pair_mode: 0 intact, 1 broken in tension, 2 broken in shear; pair_dropped: 1 once fully separated
     pair_g0: gap at which the broken spring carries no normal force [m]
     pair_tbreak: time of failure [s] (−1 while intact)
-    pair_work: work done on the spring so far [J/m]; pair_efrac: energy dissipated by its failure [J/m]
+    pair_inelastic: work done on the spring so far beyond its stored energy, W − ½Fn²/Kn − ½Fs²/Ks [J/m]: 0 while
+    it has stayed elastic (the spring kernel then skips it), its failure's dissipation once broken, plus friction
+    after; pair_efrac: energy dissipated by its failure [J/m] (pair_inelastic at the step it broke)
     pair_damp: work its dashpot has dissipated so far [J/m]; elem_damp: work the block's bulk viscosity and the
     local damping of its nodes have dissipated so far [J/m]; elem_absorbed: work its nodes' boundary dashpots have
     absorbed so far [J/m] (one entry per item, written by its own thread only, so no two threads add to one address:
@@ -188,7 +191,7 @@ class State:
     pair_dropped: wp.array
     pair_g0: wp.array
     pair_tbreak: wp.array
-    pair_work: wp.array
+    pair_inelastic: wp.array
     pair_efrac: wp.array
     pair_damp: wp.array
     elem_damp: wp.array
