@@ -193,7 +193,7 @@ class Simulation:
     def step(self, gas: bool = True) -> None:
         """Advance rock (and gas) by one explicit step (METHOD §3.1); ``gas=False`` freezes the explosive.
 
-        Order: springs and failure, and the rock's CST; then its gather, loads and block contact, and (reading only
+        Order: springs and failure, then the rock's CST with the springs' forces; then its loads and block contact, and (reading only
         x, v and the new pair_mode) the gas's particle–edge contact, crack gas, P2G and grid update, which write
         their rock loads into their own buffers; the gas loads are added to the rock's forces; then the rock's
         integration and the gas's G2P and EOS. With ``simulation.threads = 2``, on the steps where timing found it

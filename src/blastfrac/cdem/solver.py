@@ -9,17 +9,18 @@ from .._warp import Launcher
 from ..model.model import Model, State
 from .boundary import launch_edge_loads
 from .contact import BlockContact
-from .kernels_element import launch_element_forces, launch_gather_springs
+from .kernels_element import launch_element_forces
 from .kernels_integrate import launch_integrate
 from .kernels_spring import launch_spring_forces, spring_model, spring_scalars, spring_state
 
 
 #: per stage, the items from which two threads split it, in units of CDEMSolver.split_min interfaces: a stage is split
 #: where it costs more than ~0.5 ms (per item at 234k triangles on one core: 53 ns a spring interface, 15 ns a CST
-#: block, 4 ns a gathered node, 10 ns an integrated block; two hand-offs of ~85 µs must be paid for)
+#: block (now with its nodes' spring forces, which a separate gather pass added at 4 ns a node), 10 ns an integrated
+#: block; two hand-offs of ~85 µs must be paid for)
 #: block contact's scans over the whole rock: ~2 ns a spring for the changes' scan, ~7 ns a node for the displacement
 #: check (at 113k blocks, one core)
-SPLIT_SCALE = {"springs": 1, "blocks": 3, "gather": 12, "integrate": 5, "pair_changes": 20, "displacement": 5}
+SPLIT_SCALE = {"springs": 1, "blocks": 3, "integrate": 5, "pair_changes": 20, "displacement": 5}
 
 
 class CDEMSolver:
@@ -38,8 +39,8 @@ class CDEMSolver:
         # Captured rock step (step_captured): None, or (key, graph); graph_steps counts its replays
         self._graph = None
         self.graph_steps = 0
-        # Two threads (Simulation with simulation.threads = 2 sets pool): the springs, the CST blocks, the gather and
-        # the integration each run in two halves, the second in the pool's thread (each item keeps its own energy
+        # Two threads (Simulation with simulation.threads = 2 sets pool): the springs, the CST blocks (with the
+        # gather of the spring forces) and the integration each run in two halves, the second in the pool's thread (each item keeps its own energy
         # accounts, so nothing is shared and the result is one thread's to the bit). A hand-off costs ~85 µs here,
         # so a stage is split only from SPLIT_SCALE[stage]·split_min items on (split_min interfaces: ~0.5 ms of
         # springs; the other stages cost less per item)
@@ -101,30 +102,11 @@ class CDEMSolver:
                         structs=self._springs(state))
 
     def forces_springs_blocks(self, state: State, dt: float, t: float) -> None:
-        """3a and 3b together: the springs with failure and the CST blocks (f = f_int), which read x and v and write
-        nothing the other reads. Where both run in two halves, each thread runs its half of the springs and then its
-        half of the blocks: one hand-off to the second thread instead of two (~0.1–0.2 ms each on a 2-core VM).
-        Otherwise as ``forces_springs`` then the blocks. ``forces_rest(..., blocks_done=True)`` then skips 3b."""
-        m = self.model
-        if not (self.splits("springs", m.interface_count) and self.splits("blocks", m.element_count)):
-            self.forces_springs(state, dt, t)
-            self._in_halves("blocks", m.element_count, launch_element_forces, m, state, dt, self.launch)
-            return
-        self._set_clock(t)
-        structs = self._springs(state)
-        hi, he = m.interface_count // 2, m.element_count // 2
-
-        def second() -> None:
-            launch_spring_forces(m, state, dt, self.clock, self.launch, first=hi, count=m.interface_count - hi,
-                                 key="b", structs=structs)
-            launch_element_forces(m, state, dt, self.launch, first=he, count=m.element_count - he, key="b")
-
-        fut = self.pool.submit(second)
-        try:
-            launch_spring_forces(m, state, dt, self.clock, self.launch, first=0, count=hi, key="a", structs=structs)
-            launch_element_forces(m, state, dt, self.launch, first=0, count=he, key="a")
-        finally:
-            fut.result()
+        """3a then 3b: the springs with failure, then the CST blocks with their nodes' spring forces (f = f_int +
+        f_springs; the blocks read the pair forces of every interface, so the springs finish first, in both halves
+        where they split). ``forces_rest(..., blocks_done=True)`` then skips 3b."""
+        self.forces_springs(state, dt, t)
+        self._in_halves("blocks", self.model.element_count, launch_element_forces, self.model, state, dt, self.launch)
 
     def _in_halves(self, stage: str, n: int, launch, *args, **kwargs) -> None:
         """``launch(*args, first=…, count=…, key=…, **kwargs)`` over items 0 … n − 1: in two halves, the second in the
@@ -149,18 +131,21 @@ class CDEMSolver:
                     self._capturing or stage not in self._split_ready)
 
     def forces_rest(self, state: State, dt: float, t: float, beside=None, blocks_done: bool = False) -> None:
-        """3b–3e: CST stresses and f = f_int, spring gather, loads, block contact (writes f, reads pair_mode).
+        """3b–3e: CST stresses and f = f_int + f_springs, loads, block contact (writes f, reads pair_mode).
 
         ``beside``: a stage group independent of these (the gas's forces) to run in the pool's thread meanwhile. It is
-        handed over where the pool is free for it: at once when the group's first stage (the CST blocks, or the gather
-        with ``blocks_done``) runs in one launch, else after the last of the stages that run in two halves (CST,
-        gather, and block contact's whole-rock scans), so that it overlaps
+        handed over where the pool is free for it: at once when the group's first stage that could split (the CST
+        blocks, or with ``blocks_done`` block contact's scan of the springs) runs in one launch, else after the last of
+        the stages that run in two halves (CST, block contact's whole-rock scans), so that it overlaps
         block contact's serial rest instead of holding up a half (the shipped confined P0: the rock's rest 8.5 ms
         with the gas handed over first, the CST's second half waiting behind it). Without a pool it runs here, last.
         ``blocks_done``: 3b ran already (``forces_springs_blocks``)."""
         m = self.model
         fut = []
-        first = ("gather", m.node_count) if blocks_done else ("blocks", m.element_count)
+        scans = self.contact is not None and self.contact.active and self.contact.kn_area != 0.0 and \
+            bool(self.contact.fan_cache)
+        first = ("blocks", m.element_count) if not blocks_done else \
+            ("pair_changes", m.spring_count if scans else 0)
 
         def hand_over() -> None:
             if beside is not None and not fut:
@@ -169,9 +154,8 @@ class CDEMSolver:
         try:
             if beside is not None and self.pool is not None and not self.splits(*first):
                 hand_over()
-            if not blocks_done:
-                self._in_halves("blocks", m.element_count, launch_element_forces, m, state, dt, self.launch)  # 3b
-            self._in_halves("gather", m.node_count, launch_gather_springs, m, state, self.launch)  # 3c f += springs
+            if not blocks_done:                                   # 3b-c f = f_int + springs
+                self._in_halves("blocks", m.element_count, launch_element_forces, m, state, dt, self.launch)
             self.set_pulses(state, t)
             launch_edge_loads(self.model, state, self.dt_prev, self.launch)   # 3d pressure pulses, in-situ tractions
             if self.contact is not None:                          # 3e node-to-edge block contact
