@@ -68,8 +68,13 @@ def test_cached_contact_equals_full_search():
                 pm = st.pair_mode.numpy().copy()
                 pm[extra & (pm == 0)] = 2
                 st.pair_mode.assign(pm)
+            ca.rescan_springs()               # not listed by the spring kernel: said so
         for solver, st in runs:
             solver.forces(st, dt, k * dt)
+        # every change of a spring's state has been seen (the spring kernel lists the springs it breaks or drops,
+        # and the pass reads that list instead of every spring)
+        assert np.array_equal(ca.seen_mode.numpy(), st_a.pair_mode.numpy()), f"a mode change missed at step {k}"
+        assert np.array_equal(ca.seen_dropped.numpy(), st_a.pair_dropped.numpy()), f"a drop missed at step {k}"
         assert _equal(st_a.f.numpy(), st_b.f.numpy(), cpu), f"contact forces differ at step {k}"
         for name in HISTORY:
             assert _equal(getattr(ca, name).numpy(), getattr(cb, name).numpy(), cpu), f"{name} differs at step {k}"
@@ -88,6 +93,48 @@ def test_cached_contact_equals_full_search():
           f"{np.mean(listed):.0f} cached against {np.mean(candidates):.0f} uncached")
     assert held_contacts >= 10
     assert np.mean(listed) < 0.7 * np.mean(candidates)
+
+
+def test_every_spring_change_reaches_the_contact_pass():
+    """After the first pass, block contact reads only the springs the spring kernel listed as broken or dropped
+    (kernels_spring.list_change) instead of every spring's state: after each pass the states it has seen must be
+    the springs' own, while springs break and drop during the run, on one thread and with the springs in two
+    halves (two lists)."""
+    m, mode, drop, _ = _cracked(seed=5)
+    rng = np.random.default_rng(7)
+    v = np.repeat(rng.normal(0.0, 400.0, (m.element_count, 2)), 3, axis=0)   # fast enough to open and drop faces
+    dt = 0.5 * m.stable_dt
+    for halves in (False, True):
+        solver = CDEMSolver(m, block_contact=True)
+        if halves:                             # the two halves in order on this thread: two slots, two lists
+            solver.splits = lambda stage, n: stage == "springs"
+            solver.pool = _InOrder()
+            solver._split_ready.add("springs")
+        st = _state(m, mode, drop, v)
+        c = solver.contact
+        c.active = True
+        for k in range(450):                   # faces open past L0 and drop from step ~400
+            solver.forces(st, dt, k * dt)
+            assert np.array_equal(c.seen_mode.numpy(), st.pair_mode.numpy()), f"a break missed at step {k}"
+            assert np.array_equal(c.seen_dropped.numpy(), st.pair_dropped.numpy()), f"a drop missed at step {k}"
+            assert solver.pair_change_count.numpy().sum() == 0          # each pass empties the lists
+            solver.integrate(st, dt)
+        broke = int(np.count_nonzero((st.pair_mode.numpy() > 0) & (mode == 0)))
+        dropped = int(np.count_nonzero(st.pair_dropped.numpy() > drop))
+        assert broke > 0 and dropped > 0, (broke, dropped)       # both lists were exercised
+
+
+class _InOrder:
+    """A stand-in for the solver's thread pool that runs what it is given at once, on this thread."""
+
+    def submit(self, f, *a, **k):
+        class Done:
+            def __init__(self, r):
+                self.r = r
+
+            def result(self):
+                return self.r
+        return Done(f(*a, **k))
 
 
 def test_hash_rebuilt_on_displacement_finds_what_a_fresh_hash_finds():

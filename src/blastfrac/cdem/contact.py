@@ -86,8 +86,10 @@ end of the demo), so the pass works from caches that change only when a spring d
 
 - per node, its tributary length and open flag, its fan_exclusions mask and its fan candidates: the nodes at its
   vertex of other blocks, not excluded, with an exposed edge there (at most FAN_CACHE; more: walk the fan). They
-  depend on spring states only; mark_pair_changes compares those with the last step's and refresh_fan_cache
-  rebuilds the caches of the nodes at both vertices of a changed spring's interface;
+  depend on spring states only; the spring kernel lists the springs it breaks or drops (kernels_spring.list_change),
+  mark_listed_changes compares those with the states last seen (the first pass, and one after ``rescan_springs``,
+  scans every spring: mark_pair_changes) and refresh_fan_cache rebuilds the caches of the nodes at both vertices of
+  a changed spring's interface;
 - select_contact_nodes lists the nodes the contact pass has anything to do for, from the caches: a held node
   without contact only if one of its candidates passes the corner sign test and one of that corner's exposed
   edges may pass consider_edge (edge_may_take, a conservative ξ and wedge test). At the demo's end ~200 of
@@ -129,6 +131,7 @@ from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh
 from .contact_fan import (
     append_vertices,
     list_candidates,
+    mark_listed_changes,
     mark_pair_changes,
     refresh_fan_cache,
     select_contact_nodes,
@@ -283,6 +286,9 @@ class BlockContact:
         # CDEMSolver._in_halves, where the solver runs stages in two threads (it sets this): the scan of the springs'
         # changes and the displacement check, both over the whole rock, then run in two halves
         self.in_halves = None
+        # (changes, change_count): the springs whose state changed since the last pass, as the spring kernel lists
+        # them (kernels_spring.list_change; CDEMSolver sets it). None: scan every spring each pass
+        self.changes = None
         self._b_listed = False
         self._cache_fresh = False
         self._counts = wp.zeros(2, dtype=wp.int32, device=d)          # dirty vertices, listed nodes
@@ -357,14 +363,24 @@ class BlockContact:
         wp.capture_if(self._check_due, on_true=self._check_moved, state=state)
         wp.capture_if(self._rebuild_due, on_true=self._rebuild, state=state)
         self._counts.zero_()
-        if use_cache:
-            # caches of the vertices where a spring changed state since the last call (of every vertex at first)
-            if m.spring_count:
+        if use_cache and m.spring_count:
+            # caches of the vertices where a spring changed state since the last call (of every vertex at first):
+            # the first pass scans every spring, the later ones the springs the spring kernel listed
+            if self._cache_fresh and self.changes is not None:
+                dim, stride = self._lanes(len(self.changes[0]))
+                self._launch(mark_listed_changes, dim,
+                             [stride, self.changes[0], self.changes[1], state.pair_mode, state.pair_dropped,
+                              self.pair_vertex, self._clock, self.seen_mode, self.seen_dropped, self.vertex_stamp,
+                              self._counts, self._dirty_vertices, self.iface_slots, self.slot_samples,
+                              self.sample_pos, self.sorted_code])
+            else:
                 self._halves("pair_changes", m.spring_count, self._mark_pair_changes, state)
                 if self._b_listed:
                     self._launch(append_vertices, 1, [self._counts, self._dirty_vertices, self._counts_b,
                                                       self._dirty_b])
                     self._b_listed = False
+            if self.changes is not None:
+                self.changes[1].zero_()
         if hand_over is not None:
             hand_over()
         if use_cache:
@@ -386,6 +402,11 @@ class BlockContact:
                      [node_list, counts, stride, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist, prm,
                       state.pair_mode, state.pair_dropped, state.x, state.v, self._clock, float(dt), state.f,
                       state.energy_acc])
+
+    def rescan_springs(self) -> None:
+        """The spring states (pair_mode, pair_dropped) were changed outside the spring kernel, which lists the
+        springs it breaks and drops (a test, a stage that edits them): the next pass scans every spring."""
+        self._cache_fresh = False
 
     def _halves(self, stage: str, n: int, launch, *args) -> None:
         """``launch(*args, first=…, count=…, key=…)`` over items 0 … n − 1, in two halves on two threads where the

@@ -34,6 +34,17 @@ def inelastic_work(f0: wp.vec2d, fn: wp.float64, fs: wp.float64, dn: wp.float64,
     return w - (stored_spring_energy(fn, fs, kn, ks) - stored_spring_energy(f0[0], f0[1], kn, ks))
 
 
+@wp.func
+def list_change(changes: wp.array(dtype=wp.int32), change_count: wp.array(dtype=wp.int32), slot: wp.int32,
+                k: wp.int32):
+    """Append spring k, whose mode or dropped flag this step changed, to slot's list (changes[slot·cap …], cap =
+    half the array, counted in change_count[slot]): block contact's pass reads these springs instead of scanning
+    every spring's state (contact_fan.mark_listed_changes). A spring changes at most twice over a run (it breaks,
+    it is dropped), so a list of twice the springs never fills, even if no pass reads it."""
+    cap = changes.shape[0] // 2
+    changes[slot * cap + wp.atomic_add(change_count, slot, 1)] = k
+
+
 @wp.struct
 class SpringModel:
     """The springs' fixed data (cdem/kernels_spring.py): the nodes of each pair, per interface the stiffness Kn, Ks
@@ -60,7 +71,8 @@ class SpringModel:
 class SpringState:
     """Each spring's state (a State's pair_* arrays): force (Fn, Fs) [N/m], strengths, mode, dropped, gap at
     break g0 [m], break time [s], work beyond the stored energy (pair_inelastic), fracture energy and dashpot work
-    [J/m], and the force on its j node [N/m]."""
+    [J/m], and the force on its j node [N/m]; and the lists of the springs whose mode or dropped flag changed
+    (``list_change``: two slots of 2P entries, the counts; the solver's, read by block contact)."""
 
     F: wp.array(dtype=wp.vec2d)
     strength: wp.array(dtype=wp.vec2d)
@@ -72,6 +84,8 @@ class SpringState:
     efrac: wp.array(dtype=wp.float64)
     damp: wp.array(dtype=wp.float64)
     force: wp.array(dtype=wp.vec2d)
+    changes: wp.array(dtype=wp.int32)
+    change_count: wp.array(dtype=wp.int32)
 
 
 def spring_model(model, sm: SpringModel | None = None) -> SpringModel:
@@ -93,9 +107,18 @@ def spring_scalars(model) -> tuple:
             int(model.per_pair_law), int(model.breakable), model.crush)
 
 
-def spring_state(state) -> SpringState:
-    """The SpringState of a State (the same arrays)."""
+def change_lists(pair_count: int, device) -> tuple:
+    """(changes, change_count) for ``list_change``: two slots of 2·pair_count entries each, and their counts."""
+    return (wp.zeros(4 * max(1, pair_count), dtype=wp.int32, device=device),
+            wp.zeros(2, dtype=wp.int32, device=device))
+
+
+def spring_state(state, changes: tuple | None = None) -> SpringState:
+    """The SpringState of a State (the same arrays); changes: (changes, change_count) of ``change_lists`` (the
+    solver's, which block contact reads), or None for lists of its own."""
     ss = SpringState()
+    ss.changes, ss.change_count = changes if changes is not None else change_lists(len(state.pair_mode),
+                                                                                   state.pair_mode.device)
     ss.F, ss.strength, ss.mode, ss.dropped = state.pair_F, state.pair_str, state.pair_mode, state.pair_dropped
     ss.g0, ss.tbreak, ss.inelastic, ss.efrac, ss.force = (state.pair_g0, state.pair_tbreak, state.pair_inelastic,
                                                     state.pair_efrac, state.pair_force)
@@ -112,8 +135,11 @@ def eval_spring_forces(
     dt: wp.float64,
     clock: wp.array(dtype=wp.float64),
     first: wp.int32,
+    slot: wp.int32,
 ):
-    """Update both springs of interface q; write the force on each pair's j node (global axes) [N/m].
+    """Update both springs of interface q; write the force on each pair's j node (global axes) [N/m]; list the
+    springs whose mode or dropped flag changes in ss.changes' slot (``list_change``; 0 for the first or only part of
+    the interfaces, 1 for the second).
 
     With zeta > 0 a dashpot (materials.interface.spring_dashpot) acts beside each spring that carries
     load (intact, or broken and closed); its force is not part of the stored spring force, so it never
@@ -190,6 +216,7 @@ def eval_spring_forces(
                     ss.mode[k] = new_mode
                     ss.tbreak[k] = clock[0]
                     ss.efrac[k] = w
+                    list_change(ss.changes, ss.change_count, slot, k)
         else:
             # frame of a broken pair: the e1 face (node-to-face contact of j against the edge i_a→i_b of e1).
             # The midpoint frame is meaningless once the other pair has opened or the blocks have turned.
@@ -203,8 +230,10 @@ def eval_spring_forces(
             # separated (open by more than L0, slid by L0/2), or crossed by more than L0/2: leave it to §1.5
             if wp.abs(gap - g0) > half * l0 and gap - g0 < wp.float64(0.0):
                 ss.dropped[k] = 1
+                list_change(ss.changes, ss.change_count, slot, k)
             elif gap - g0 > l0 or wp.abs(wp.dot(rel, tt)) > half * l0:
                 ss.dropped[k] = 1
+                list_change(ss.changes, ss.change_count, slot, k)
             else:
                 r2 = spring_update_broken(f0[1], gap, g0, ds, kn, ks, law[1])
                 fn = r2[0]
@@ -230,5 +259,5 @@ def launch_spring_forces(model, state, dt: float, clock: wp.array, launch=wp.lau
     sm, ss = structs if structs is not None else (spring_model(model), spring_state(state))
     site = {} if key is None else {"key": key}        # a Launcher's call site (the plain wp.launch has none)
     launch(eval_spring_forces, dim=count,
-           inputs=[sm, ss, state.x, state.v, wp.float64(dt), clock, first],
+           inputs=[sm, ss, state.x, state.v, wp.float64(dt), clock, first, int(first > 0)],
            device=model.device, **site)

@@ -11,7 +11,7 @@ from .boundary import launch_edge_loads
 from .contact import BlockContact
 from .kernels_element import launch_element_forces
 from .kernels_integrate import launch_integrate
-from .kernels_spring import launch_spring_forces, spring_model, spring_scalars, spring_state
+from .kernels_spring import change_lists, launch_spring_forces, spring_model, spring_scalars, spring_state
 
 
 #: per stage, the items from which two threads split it, in units of CDEMSolver.split_min interfaces: a stage is split
@@ -40,8 +40,8 @@ class CDEMSolver:
         self._graph = None
         self.graph_steps = 0
         # Two threads (Simulation with simulation.threads = 2 sets pool): the springs, the CST blocks (with the
-        # gather of the spring forces) and the integration each run in two halves, the second in the pool's thread (each item keeps its own energy
-        # accounts, so nothing is shared and the result is one thread's to the bit). A hand-off costs ~85 µs here,
+        # gather of the spring forces) and the integration each run in two halves, the second in the pool's thread
+        # (each item keeps its own energy accounts, so nothing is shared and the result is one thread's to the bit). A hand-off costs ~85 µs here,
         # so a stage is split only from SPLIT_SCALE[stage]·split_min items on (split_min interfaces: ~0.5 ms of
         # springs; the other stages cost less per item)
         self.pool = None
@@ -56,6 +56,12 @@ class CDEMSolver:
         self._spring_model = spring_model(model)
         self._spring_scalars = spring_scalars(model)
         self._spring_states: dict = {}
+        # the springs whose mode or dropped flag changed since block contact's last pass, listed by the spring
+        # kernel (kernels_spring.list_change, a slot per half of the interfaces); the contact pass reads them and
+        # clears the counts
+        self.pair_changes, self.pair_change_count = change_lists(model.spring_count, model.device)
+        if self.contact is not None:
+            self.contact.changes = (self.pair_changes, self.pair_change_count)
 
     def _springs(self, state: State) -> tuple:
         """(SpringModel, SpringState) for ``state``, the model's scalars as they are now."""
@@ -65,7 +71,8 @@ class CDEMSolver:
             self._spring_scalars = sc
         ss = self._spring_states.get(id(state))
         if ss is None or ss[0] is not state:
-            ss = self._spring_states[id(state)] = (state, spring_state(state))
+            ss = self._spring_states[id(state)] = (state, spring_state(state, (self.pair_changes,
+                                                                                self.pair_change_count)))
         return self._spring_model, ss[1]
 
     def _set_clock(self, t: float) -> None:
