@@ -97,9 +97,10 @@ def test_cached_contact_equals_full_search():
 
 def test_every_spring_change_reaches_the_contact_pass():
     """After the first pass, block contact reads only the springs the spring kernel listed as broken or dropped
-    (kernels_spring.list_change) instead of every spring's state: after each pass the states it has seen must be
-    the springs' own, while springs break and drop during the run, on one thread and with the springs in two
-    halves (two lists)."""
+    (kernels_spring.list_change) instead of every spring's state, and merges the nodes it flags for the first time
+    into its candidate list instead of scanning every node's flag (merge_candidates): after each pass the states it
+    has seen must be the springs' own and the list every flagged node in order, while springs break and drop
+    during the run, on one thread and with the springs in two halves (two lists)."""
     m, mode, drop, _ = _cracked(seed=5)
     rng = np.random.default_rng(7)
     v = np.repeat(rng.normal(0.0, 400.0, (m.element_count, 2)), 3, axis=0)   # fast enough to open and drop faces
@@ -113,15 +114,21 @@ def test_every_spring_change_reaches_the_contact_pass():
         st = _state(m, mode, drop, v)
         c = solver.contact
         c.active = True
+        merged = 0
         for k in range(450):                   # faces open past L0 and drop from step ~400
             solver.forces(st, dt, k * dt)
             assert np.array_equal(c.seen_mode.numpy(), st.pair_mode.numpy()), f"a break missed at step {k}"
             assert np.array_equal(c.seen_dropped.numpy(), st.pair_dropped.numpy()), f"a drop missed at step {k}"
             assert solver.pair_change_count.numpy().sum() == 0          # each pass empties the lists
+            # the candidate list, merged from the newly flagged nodes (merge_candidates), is every flagged node
+            cand = c._cand_list.numpy()[: c._cand_count.numpy()[0]]
+            assert np.array_equal(cand, np.flatnonzero(c.node_flag.numpy())), f"candidate list wrong at step {k}"
+            merged = max(merged, int(c.new_count.numpy()[0]))
             solver.integrate(st, dt)
         broke = int(np.count_nonzero((st.pair_mode.numpy() > 0) & (mode == 0)))
         dropped = int(np.count_nonzero(st.pair_dropped.numpy() > drop))
         assert broke > 0 and dropped > 0, (broke, dropped)       # both lists were exercised
+        assert merged > 1                                        # and merges of several new candidates
 
 
 class _InOrder:

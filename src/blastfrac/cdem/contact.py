@@ -133,6 +133,7 @@ from .contact_fan import (
     list_candidates,
     mark_listed_changes,
     mark_pair_changes,
+    merge_candidates,
     refresh_fan_cache,
     select_contact_nodes,
 )
@@ -297,6 +298,8 @@ class BlockContact:
         self._counts_all = wp.array([0, n], dtype=wp.int32, device=d)
         self._cand_list = wp.zeros(n, dtype=wp.int32, device=d)       # list_candidates
         self._cand_count = wp.zeros(1, dtype=wp.int32, device=d)
+        self.new_nodes = wp.zeros(n, dtype=wp.int32, device=d)        # flagged by this refresh for the first time
+        self.new_count = wp.zeros(1, dtype=wp.int32, device=d)
         self._cpu = wp.get_device(d).is_cpu
         self._launch = Launcher()                 # recorded launches (packing costs more than a small mesh's pass)
         self._structs()
@@ -314,7 +317,8 @@ class BlockContact:
         hsh.cell_starts, hsh.cell_ends, hsh.sorted_xy, hsh.sorted_code = (self.cell_starts, self.cell_ends,
                                                                           self.sorted_xy, self.sorted_code)
         cache = self.s_cache = ContactCache()
-        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "query_after"):
+        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "query_after",
+                  "new_nodes", "new_count"):
             setattr(cache, k, getattr(self, k))
         hist = self.s_hist = ContactHistory()
         hist.slot, hist.fs, hist.d0, hist.p, hist.kc = (self.contact_slot, self.contact_fs, self.contact_d0,
@@ -484,11 +488,16 @@ class BlockContact:
         """Rebuild the fan caches of the listed vertices (of all with refresh_all), then the candidate list."""
         m = self.model
         dim, stride = self._lanes(self.vertex_count)
+        self.new_count.zero_()
         self._launch(refresh_fan_cache, dim,
                      [refresh_all, self._counts, self._dirty_vertices, self.s_mesh, state.pair_mode,
                       state.pair_dropped, self.s_cache, self.vertex_count, stride])
-        self._cand_count.zero_()
-        self._launch(list_candidates, m.node_count, [self.node_flag, self._cand_count, self._cand_list])
+        if self._cpu and not refresh_all:
+            # the new candidates merged in node order, the list kept (flags never return to 0)
+            self._launch(merge_candidates, 1, [self.s_cache, self._cand_count, self._cand_list])
+        else:
+            self._cand_count.zero_()
+            self._launch(list_candidates, m.node_count, [self.node_flag, self._cand_count, self._cand_list])
 
     @property
     def rebuilds(self) -> int:

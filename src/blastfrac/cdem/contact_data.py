@@ -49,6 +49,8 @@ class ContactCache:
     fan_count: wp.array(dtype=wp.int32)       # −1: not cached, walk the fan
     elem_near: wp.array(dtype=wp.int32)       # step at which an open face last came near each element
     query_after: wp.array(dtype=wp.int32)     # first step an open node searches the hash again
+    new_nodes: wp.array(dtype=wp.int32)       # the nodes whose flag a refresh turned from 0 (merge_candidates)
+    new_count: wp.array(dtype=wp.int32)       # [1]: how many
 
 
 @wp.struct
