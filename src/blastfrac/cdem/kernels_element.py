@@ -1,7 +1,7 @@
 """CST blocks: updated-Lagrangian stress update and internal nodal forces.
 
 Each element owns its three nodes (3e, 3e+1, 3e+2), so it *assigns* their force, and adds the forces of their
-springs (owner-computes: a node has at most two, ``node_pairs``) in the same pass; the load and contact stages then
+springs (owner-computes: a node has at most two, ``Model.node_spring_code``) in the same pass; the load and contact stages then
 add to it.
 """
 
@@ -14,14 +14,18 @@ from ..materials.elastic import jaumann_stress_update
 
 
 @wp.func
-def spring_force_sum(acc: wp.vec2d, p: wp.vec2i, sign: wp.vec2d, pair_force: wp.array(dtype=wp.vec2d)):
-    """acc + Σ sign·f_pair over the (at most two; −1: none) springs p of a node [N/m]: the owner-computes gather of
-    the spring forces, in the block's pass, which then writes each node's force once (a separate gather pass read
-    and wrote every node's force again: 2 ms a step of the shipped confined P0's ~27 on one thread)."""
-    if p[0] >= 0:
-        acc = acc + sign[0] * pair_force[p[0]]
-    if p[1] >= 0:
-        acc = acc + sign[1] * pair_force[p[1]]
+def spring_force_sum(acc: wp.vec2d, code: wp.vec2i, pair_force: wp.array(dtype=wp.vec2d)):
+    """acc + Σ ±f_pair over the (at most two) springs of a node [N/m], code = Model.node_spring_code (2p + 1: the
+    node is pair p's i node, −f_pair; 2p: its j node, +f_pair; −1: none): the owner-computes gather of the spring
+    forces, in the block's pass, which then writes each node's force once (a separate gather pass read and wrote
+    every node's force again: 2 ms a step of the shipped confined P0's ~27 on one thread). The side is a factor
+    ±1.0, not a branch (which side a node is on has no pattern the CPU could predict)."""
+    one = wp.float64(1.0)
+    two = wp.float64(2.0)
+    for k in range(2):
+        c = code[k]
+        if c >= 0:
+            acc = acc + (one - two * wp.float64(c & 1)) * pair_force[c >> 1]
     return acc
 
 
@@ -39,8 +43,7 @@ def eval_element_forces(
     dt: wp.float64,
     first: wp.int32,
     springs: wp.int32,
-    node_pairs: wp.array(dtype=wp.vec2i),
-    node_pair_sign: wp.array(dtype=wp.vec2d),
+    node_spring_code: wp.array(dtype=wp.vec2i),
     pair_force: wp.array(dtype=wp.vec2d),
     f: wp.array(dtype=wp.vec2d),
     elem_damp: wp.array(dtype=wp.float64),
@@ -92,9 +95,9 @@ def eval_element_forces(
     f1 = h * wp.vec2d(s[0] * g1[0] + s[2] * g1[1], s[2] * g1[0] + s[1] * g1[1])
     f2 = h * wp.vec2d(s[0] * g2[0] + s[2] * g2[1], s[2] * g2[0] + s[1] * g2[1])
     if springs != 0:
-        f0 = spring_force_sum(f0, node_pairs[n0], node_pair_sign[n0], pair_force)
-        f1 = spring_force_sum(f1, node_pairs[n0 + 1], node_pair_sign[n0 + 1], pair_force)
-        f2 = spring_force_sum(f2, node_pairs[n0 + 2], node_pair_sign[n0 + 2], pair_force)
+        f0 = spring_force_sum(f0, node_spring_code[n0], pair_force)
+        f1 = spring_force_sum(f1, node_spring_code[n0 + 1], pair_force)
+        f2 = spring_force_sum(f2, node_spring_code[n0 + 2], pair_force)
     f[n0] = f0
     f[n0 + 1] = f1
     f[n0 + 2] = f2
@@ -110,5 +113,5 @@ def launch_element_forces(model, state, dt: float, launch=wp.launch, first: int 
            inputs=[state.x, state.v, state.sigma, wp.float64(model.lam), wp.float64(model.mu),
                    wp.float64(model.density), wp.float64(model.c_p), wp.float64(model.q_quad),
                    wp.float64(model.q_lin), wp.float64(dt), first, int(model.interface_count > 0),
-                   model.node_pairs, model.node_pair_sign, state.pair_force],
+                   model.node_spring_code, state.pair_force],
            outputs=[state.f, state.elem_damp], device=model.device, **site)

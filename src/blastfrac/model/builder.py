@@ -261,7 +261,7 @@ class ModelBuilder:
             node_mass=arr(h["node_mass"], wp.float64),
             node_X=arr(h["node_X"], wp.vec2d),
             node_pairs=arr(self.topology.node_pairs.astype(np.int32), wp.vec2i),
-            node_pair_sign=arr(self.topology.node_pair_sign.astype(np.float64), wp.vec2d),
+            node_spring_code=arr(node_spring_code(self.topology), wp.vec2i),
             node_bc=arr(h["node_bc"].astype(np.int32), wp.int32),
             bc_P=arr(h["bc_P"], wp.mat22d),
             bc_C=arr(h["bc_C"], wp.mat22d),
@@ -308,6 +308,14 @@ def iface_spring(h: dict) -> np.ndarray:
         if not np.array_equal(c[0::2], c[1::2]):
             raise AssertionError("the two pairs of an interface must share Kn, Ks, Ac and L0")
     return np.stack([c[0::2] for c in cols], 1) if len(cols[0]) else np.zeros((0, 4))
+
+
+def node_spring_code(topology) -> np.ndarray:
+    """2p + (1 if the node is pair p's i node) for each of a node's springs, −1 for none, [N, 2] int32
+    (Model.node_spring_code)."""
+    p, sign = topology.node_pairs, topology.node_pair_sign
+    code = np.where(p >= 0, 2 * p + (sign < 0), -1)
+    return code.astype(np.int32)
 
 
 def iface_law(h: dict) -> np.ndarray:

@@ -21,7 +21,10 @@ class Model:
 
     node_mass: lumped mass ρA/3 [kg/m], [N]
     node_X: reference (initial) position [m], [N] vec2d
-    node_pairs, node_pair_sign: the springs of each node and its side (+1 j, −1 i), [N] vec2i
+    node_pairs: the (at most two) springs of each node, −1 if none, [N] vec2i
+    node_spring_code: the same springs with the node's side, 2p + 1 where the node is the pair's i node (it takes
+        −f_pair) and 2p where it is the j node (+f_pair), −1 if none, [N] vec2i: what the block pass reads to add
+        the spring forces (8 bytes a node, where node_pairs and a sign vec2d took 24; topology.node_pair_sign)
     node_bc: index into the bc_* arrays or −1, [N] int32
     bc_P: velocity projection of a constrained node (0 fixed, I−nnᵀ roller, I free), [C] mat22d
     bc_C: dashpot matrix of a viscous node [N·s/m per m], [C] mat22d
@@ -60,7 +63,7 @@ class Model:
     node_mass: wp.array
     node_X: wp.array
     node_pairs: wp.array
-    node_pair_sign: wp.array
+    node_spring_code: wp.array
     node_bc: wp.array
     bc_P: wp.array
     bc_C: wp.array
