@@ -127,7 +127,7 @@ import numpy as np
 import warp as wp
 
 from .._warp import Launcher
-from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh, ContactParams
+from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMarks, ContactMesh, ContactParams
 from .contact_fan import (
     append_vertices,
     list_candidates,
@@ -320,6 +320,10 @@ class BlockContact:
         for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "query_after",
                   "new_nodes", "new_count"):
             setattr(cache, k, getattr(self, k))
+        marks = self.s_marks = ContactMarks()
+        for k in ("pair_vertex", "seen_mode", "seen_dropped", "vertex_stamp", "iface_slots", "slot_samples",
+                  "sample_pos", "sorted_code"):
+            setattr(marks, k, getattr(self, k))
         hist = self.s_hist = ContactHistory()
         hist.slot, hist.fs, hist.d0, hist.p, hist.kc = (self.contact_slot, self.contact_fs, self.contact_d0,
                                                         self.contact_p, self.contact_kc)
@@ -374,9 +378,7 @@ class BlockContact:
                 dim, stride = self._lanes(len(self.changes[0]))
                 self._launch(mark_listed_changes, dim,
                              [stride, self.changes[0], self.changes[1], state.pair_mode, state.pair_dropped,
-                              self.pair_vertex, self._clock, self.seen_mode, self.seen_dropped, self.vertex_stamp,
-                              self._counts, self._dirty_vertices, self.iface_slots, self.slot_samples,
-                              self.sample_pos, self.sorted_code])
+                              self._clock, self.s_marks, self._counts, self._dirty_vertices])
             else:
                 self._halves("pair_changes", m.spring_count, self._mark_pair_changes, state)
                 if self._b_listed:
@@ -429,10 +431,9 @@ class BlockContact:
         if second:
             self._counts_b.zero_()
         self._launch(mark_pair_changes, count,
-                     [first, state.pair_mode, state.pair_dropped, self.pair_vertex, self._clock, self.seen_mode,
-                      self.seen_dropped, self.vertex_stamp, self._counts_b if second else self._counts,
-                      self._dirty_b if second else self._dirty_vertices, self.iface_slots, self.slot_samples,
-                      self.sample_pos, self.sorted_code], key=key)
+                     [first, state.pair_mode, state.pair_dropped, self._clock, self.s_marks,
+                      self._counts_b if second else self._counts, self._dirty_b if second else self._dirty_vertices],
+                     key=key)
         self._b_listed = self._b_listed or second        # joined by append_vertices once both halves have run
 
     def _largest_displacement(self, state, first: int = 0, count: int | None = None, key=None) -> None:

@@ -54,6 +54,21 @@ class ContactCache:
 
 
 @wp.struct
+class ContactMarks:
+    """What marking a spring's change of state reads and writes (contact_fan.mark_pair): each spring's vertex and
+    the state last seen, the vertices' stamps, each interface's two edge slots and the hash points on them."""
+
+    pair_vertex: wp.array(dtype=wp.int32)     # the mesh vertex of each spring
+    seen_mode: wp.array(dtype=wp.int32)       # pair_mode as last seen
+    seen_dropped: wp.array(dtype=wp.int32)    # pair_dropped as last seen
+    vertex_stamp: wp.array(dtype=wp.int32)    # step at which a vertex was last listed
+    iface_slots: wp.array(dtype=wp.vec2i)     # the two element edges of each interface
+    slot_samples: wp.array(dtype=wp.vec2i)    # (first, count) of each edge's hash points
+    sample_pos: wp.array(dtype=wp.int32)      # where each hash point sits in the cell order
+    sorted_code: wp.array(dtype=wp.int32)     # ± (slot + 1) of each hash point in cell order: + if exposed
+
+
+@wp.struct
 class ContactHistory:
     """Each node's contact: its edge, friction force, overlap allowance, overlap and stiffness; the losses."""
 

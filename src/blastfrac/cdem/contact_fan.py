@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from .contact_data import ContactCache, ContactMesh, ContactParams
+from .contact_data import ContactCache, ContactMarks, ContactMesh, ContactParams
 from .contact_geometry import (
     FAN_CACHE,
     WEDGE_TOL,
@@ -213,64 +213,38 @@ def held_search(
 
 
 @wp.func
-def mark_pair(
-    p: wp.int32,
-    step: wp.int32,
-    pair_mode: wp.array(dtype=wp.int32),
-    pair_dropped: wp.array(dtype=wp.int32),
-    pair_vertex: wp.array(dtype=wp.int32),
-    seen_mode: wp.array(dtype=wp.int32),
-    seen_dropped: wp.array(dtype=wp.int32),
-    vertex_stamp: wp.array(dtype=wp.int32),
-    counts: wp.array(dtype=wp.int32),
-    dirty_vertices: wp.array(dtype=wp.int32),
-    iface_slots: wp.array(dtype=wp.vec2i),
-    slot_samples: wp.array(dtype=wp.vec2i),
-    sample_pos: wp.array(dtype=wp.int32),
-    sorted_code: wp.array(dtype=wp.int32),
-):
+def mark_pair(p: wp.int32, step: wp.int32, pair_mode: wp.array(dtype=wp.int32),
+              pair_dropped: wp.array(dtype=wp.int32), marks: ContactMarks, counts: wp.array(dtype=wp.int32),
+              dirty_vertices: wp.array(dtype=wp.int32)):
     """If spring p's state differs from the one last seen: list (once each, counts[0] of them) the vertices whose
     fan caches the change makes stale, both ends of p's interface (the exposure of its edges counts at both
     vertices, the exclusion chains at p's own), and set the sorted_code sign of the hash points on the interface's
     two edges. Nothing for an unchanged spring, so a spring may be met twice."""
     mode = pair_mode[p]
     dropped = pair_dropped[p]
-    if mode != seen_mode[p] or dropped != seen_dropped[p]:
-        seen_mode[p] = mode
-        seen_dropped[p] = dropped
+    if mode != marks.seen_mode[p] or dropped != marks.seen_dropped[p]:
+        marks.seen_mode[p] = mode
+        marks.seen_dropped[p] = dropped
         q = p // 2
         for k in range(2):
-            vtx = pair_vertex[2 * q + k]
-            if wp.atomic_exch(vertex_stamp, vtx, step) != step:
+            vtx = marks.pair_vertex[2 * q + k]
+            if wp.atomic_exch(marks.vertex_stamp, vtx, step) != step:
                 dirty_vertices[wp.atomic_add(counts, 0, 1)] = vtx
         exposed = pair_mode[2 * q] != 0 and pair_mode[2 * q + 1] != 0
         for k in range(2):
-            sl = iface_slots[q][k]
+            sl = marks.iface_slots[q][k]
             code = -(sl + 1)
             if exposed:
                 code = sl + 1
-            rng = slot_samples[sl]
+            rng = marks.slot_samples[sl]
             for i in range(rng[0], rng[0] + rng[1]):
-                sorted_code[sample_pos[i]] = code
+                marks.sorted_code[marks.sample_pos[i]] = code
 
 
 @wp.kernel
-def mark_pair_changes(
-    first: wp.int32,
-    pair_mode: wp.array(dtype=wp.int32),
-    pair_dropped: wp.array(dtype=wp.int32),
-    pair_vertex: wp.array(dtype=wp.int32),
-    clock: wp.array(dtype=wp.int32),
-    seen_mode: wp.array(dtype=wp.int32),
-    seen_dropped: wp.array(dtype=wp.int32),
-    vertex_stamp: wp.array(dtype=wp.int32),
-    counts: wp.array(dtype=wp.int32),
-    dirty_vertices: wp.array(dtype=wp.int32),
-    iface_slots: wp.array(dtype=wp.vec2i),
-    slot_samples: wp.array(dtype=wp.vec2i),
-    sample_pos: wp.array(dtype=wp.int32),
-    sorted_code: wp.array(dtype=wp.int32),
-):
+def mark_pair_changes(first: wp.int32, pair_mode: wp.array(dtype=wp.int32), pair_dropped: wp.array(dtype=wp.int32),
+                      clock: wp.array(dtype=wp.int32), marks: ContactMarks, counts: wp.array(dtype=wp.int32),
+                      dirty_vertices: wp.array(dtype=wp.int32)):
     """mark_pair for every spring first, first + 1, … (the scan of the first pass, which finds every spring's
     state new, and of a pass after ``BlockContact.rescan_springs``; the others take the springs the spring kernel
     listed, ``mark_listed_changes``).
@@ -279,30 +253,14 @@ def mark_pair_changes(
     in order). A vertex whose springs change in both halves may then be listed twice (the two threads' stamps
     race); its caches are rebuilt twice, to the same values. Where the split falls between the two springs of one
     interface, both threads write that interface's sorted_code, and write the same value."""
-    p = first + wp.tid()
-    mark_pair(p, clock[0], pair_mode, pair_dropped, pair_vertex, seen_mode, seen_dropped, vertex_stamp, counts,
-              dirty_vertices, iface_slots, slot_samples, sample_pos, sorted_code)
+    mark_pair(first + wp.tid(), clock[0], pair_mode, pair_dropped, marks, counts, dirty_vertices)
 
 
 @wp.kernel
-def mark_listed_changes(
-    stride: wp.int32,
-    changes: wp.array(dtype=wp.int32),
-    change_count: wp.array(dtype=wp.int32),
-    pair_mode: wp.array(dtype=wp.int32),
-    pair_dropped: wp.array(dtype=wp.int32),
-    pair_vertex: wp.array(dtype=wp.int32),
-    clock: wp.array(dtype=wp.int32),
-    seen_mode: wp.array(dtype=wp.int32),
-    seen_dropped: wp.array(dtype=wp.int32),
-    vertex_stamp: wp.array(dtype=wp.int32),
-    counts: wp.array(dtype=wp.int32),
-    dirty_vertices: wp.array(dtype=wp.int32),
-    iface_slots: wp.array(dtype=wp.vec2i),
-    slot_samples: wp.array(dtype=wp.vec2i),
-    sample_pos: wp.array(dtype=wp.int32),
-    sorted_code: wp.array(dtype=wp.int32),
-):
+def mark_listed_changes(stride: wp.int32, changes: wp.array(dtype=wp.int32), change_count: wp.array(dtype=wp.int32),
+                        pair_mode: wp.array(dtype=wp.int32), pair_dropped: wp.array(dtype=wp.int32),
+                        clock: wp.array(dtype=wp.int32), marks: ContactMarks, counts: wp.array(dtype=wp.int32),
+                        dirty_vertices: wp.array(dtype=wp.int32)):
     """mark_pair for the springs the spring kernel listed since the last pass (kernels_spring.list_change: slot 0's
     change_count[0] entries from changes[0], then slot 1's change_count[1] from changes[cap], cap = half the
     array): on a CPU, where one thread walks the list (thread i takes items i, i + stride, …), the springs
@@ -319,8 +277,7 @@ def mark_listed_changes(
             p = changes[i]
         else:
             p = changes[cap + i - n0]
-        mark_pair(p, step, pair_mode, pair_dropped, pair_vertex, seen_mode, seen_dropped, vertex_stamp, counts,
-                  dirty_vertices, iface_slots, slot_samples, sample_pos, sorted_code)
+        mark_pair(p, step, pair_mode, pair_dropped, marks, counts, dirty_vertices)
         i += stride
 
 
