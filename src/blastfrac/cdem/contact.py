@@ -439,8 +439,8 @@ class BlockContact:
     def _largest_displacement(self, state, first: int = 0, count: int | None = None, key=None) -> None:
         """largest_displacement over nodes first … first + count − 1, into _moved[0] (first half) or _moved[1]."""
         count = self.model.node_count - first if count is None else count
-        self._launch(largest_displacement, count, [first, int(first > 0), state.x, self._x_build, self._moved],
-                     key=key)
+        self._launch(largest_displacement, 1 if self._cpu else count,
+                     [first, count, int(self._cpu), int(first > 0), state.x, self._x_build, self._moved], key=key)
 
     def _lanes(self, n: int) -> tuple[int, int]:
         """(threads, stride) of a launch over a list of at most n items whose length is on the device: one thread
