@@ -41,9 +41,9 @@ class CDEMSolver:
         self.graph_steps = 0
         # Two threads (Simulation with simulation.threads = 2 sets pool): the springs, the CST blocks (with the
         # gather of the spring forces) and the integration each run in two halves, the second in the pool's thread
-        # (each item keeps its own energy accounts, so nothing is shared and the result is one thread's to the bit). A hand-off costs ~85 µs here,
-        # so a stage is split only from SPLIT_SCALE[stage]·split_min items on (split_min interfaces: ~0.5 ms of
-        # springs; the other stages cost less per item)
+        # (each item keeps its own energy accounts, so nothing is shared and the result is one thread's to the
+        # bit). A hand-off costs ~85 µs here, so a stage is split only from SPLIT_SCALE[stage]·split_min items on
+        # (split_min interfaces: ~0.5 ms of springs; the other stages cost less per item)
         self.pool = None
         self.split_min = 10000
         self._split_ready: set = set()           # the stages whose module has loaded (the first call is serial)
@@ -142,8 +142,9 @@ class CDEMSolver:
 
         ``beside``: a stage group independent of these (the gas's forces) to run in the pool's thread meanwhile. It is
         handed over where the pool is free for it: at once when the group's first stage that could split (the CST
-        blocks, or with ``blocks_done`` block contact's scan of the springs) runs in one launch, else after the last of
-        the stages that run in two halves (CST, block contact's whole-rock scans), so that it overlaps
+        blocks, or with ``blocks_done`` block contact's scan of every spring, which only its first pass and one after
+        ``rescan_springs`` make) runs in one launch, else after the last of the stages that run in two halves (CST,
+        block contact's whole-rock scans: that scan and the displacement check), so that it overlaps
         block contact's serial rest instead of holding up a half (the shipped confined P0: the rock's rest 8.5 ms
         with the gas handed over first, the CST's second half waiting behind it). Without a pool it runs here, last.
         ``blocks_done``: 3b ran already (``forces_springs_blocks``)."""
