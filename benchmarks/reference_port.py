@@ -1,4 +1,5 @@
-"""The compiled reference's CDEM loop written as Warp kernels: what Warp's code generation costs, apart from the algorithm.
+"""The compiled reference's CDEM and MPM loops written as Warp kernels: what Warp's code generation costs, apart from
+the algorithm.
 
     python benchmarks/reference_port.py [--reference ../shared/bench-reference] [--steps 50] [--reps 5]
 
@@ -15,7 +16,15 @@ kinetic energy, broken springs, stress sums): the same algorithm to round-off. T
     blastfrac ÷ C++ = (blastfrac ÷ Warp port) × (Warp port ÷ C++),
 
 the first factor being the extra work of blastfrac's algorithm, the second Warp's code against g++ -O3 -march=native.
-``run(ref_dir)`` needs a built copy (``bench_coupled.run_reference`` makes one); ``main`` builds one itself.
+
+The same for the MPM loop (namespace ``mpm``: MLS-MPM with APIC and the quadratic B-spline, a JWL pressure from J in
+the P2G, one P2G, grid update and G2P a step, 512² grid; ``MPMPort``, ``run_mpm``). blastfrac's MPM step does more:
+a MUSL step (P2G of mass, momentum and force; grid update; G2P of the velocity; a second P2G of the momentum, the
+remap; velocity gradient, volume and motion from the remapped grid in a pass of its own), a stencil that serves the
+B-spline and uGIMP and periodic axes, and a products' update per point with programmed burn, bulk viscosity, the
+energy update implicit in p and two JWL sound speeds (the viscosity's and the time step's).
+``run(ref_dir)`` and ``run_mpm(ref_dir, n)`` need a built copy (``bench_coupled.run_reference`` makes one); ``main``
+builds one itself.
 """
 
 from __future__ import annotations
@@ -117,6 +126,170 @@ def ref_integrate(f: wp.array(dtype=wp.vec2d), inv_mass: wp.array(dtype=F64), al
     u[i] = u[i] + dt * w
 
 
+# ----------------------------------------------------------------------------- the reference's MPM loop
+@wp.func
+def ref_weights(fx: F64):
+    """Quadratic B-spline weights of the three nodes from the particle's offset fx in its base cell."""
+    return wp.vec3d(F64(0.5) * (F64(1.5) - fx) * (F64(1.5) - fx), F64(0.75) - (fx - F64(1.0)) * (fx - F64(1.0)),
+                    F64(0.5) * (fx - F64(0.5)) * (fx - F64(0.5)))
+
+
+@wp.kernel
+def ref_mpm_p2g(x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), C: wp.array(dtype=wp.mat22d),
+                J: wp.array(dtype=F64), e: wp.array(dtype=F64), ng: int, inv_dx: F64, dx: F64, stress_k: F64,
+                p_mass: F64, ja: F64, jb: F64, r1: F64, r2: F64, om: F64,
+                pres: wp.array(dtype=F64), grid: wp.array(dtype=wp.vec3d)):
+    """JWL pressure of particle p, then its APIC momentum, MLS stress impulse and mass onto its 3 × 3 nodes
+    (grid: momentum x, y and mass per node; one thread on a CPU, so the adds need no atomics there)."""
+    p = wp.tid()
+    X = x[p] * inv_dx
+    b0 = int(wp.floor(X[0] - F64(0.5)))
+    b1 = int(wp.floor(X[1] - F64(0.5)))
+    fx0 = X[0] - F64(b0)
+    fx1 = X[1] - F64(b1)
+    w0 = ref_weights(fx0)
+    w1 = ref_weights(fx1)
+    V = J[p]
+    one = F64(1.0)
+    pr = ja * (one - om / (r1 * V)) * wp.exp(-r1 * V) + jb * (one - om / (r2 * V)) * wp.exp(-r2 * V) + om * e[p] / V
+    pres[p] = pr
+    st = stress_k * V * pr
+    Cp = C[p]
+    a00 = st + p_mass * Cp[0, 0]
+    a01 = p_mass * Cp[0, 1]
+    a10 = p_mass * Cp[1, 0]
+    a11 = st + p_mass * Cp[1, 1]
+    mvx = p_mass * v[p][0]
+    mvy = p_mass * v[p][1]
+    di = F64(0.0)                  # the node offsets i, j as floats (F64(i) would retype the loop's int)
+    for i in range(3):
+        dpx = (di - fx0) * dx
+        dj = F64(0.0)
+        for j in range(3):
+            dpy = (dj - fx1) * dx
+            wt = w0[i] * w1[j]
+            gi = (b0 + i) * ng + (b1 + j)
+            grid[gi] = grid[gi] + wp.vec3d(wt * (mvx + a00 * dpx + a01 * dpy), wt * (mvy + a10 * dpx + a11 * dpy),
+                                           wt * p_mass)
+            dj += F64(1.0)
+        di += F64(1.0)
+
+
+@wp.kernel
+def ref_mpm_grid(grid: wp.array(dtype=wp.vec3d), ng: int, bound: int, gv: wp.array(dtype=wp.vec2d),
+                 gm: wp.array(dtype=F64)):
+    """Grid velocity = momentum / mass with the reference's sticky-slip walls; the accumulator is zeroed."""
+    gi = wp.tid()
+    i = gi / ng
+    j = gi % ng
+    g = grid[gi]
+    grid[gi] = wp.vec3d()
+    gm[gi] = g[2]
+    vx = F64(0.0)
+    vy = F64(0.0)
+    if g[2] > F64(0.0):
+        vx = g[0] / g[2]
+        vy = g[1] / g[2]
+    if i < bound and vx < F64(0.0):
+        vx = F64(0.0)
+    if i > ng - bound - 1 and vx > F64(0.0):
+        vx = F64(0.0)
+    if j < bound and vy < F64(0.0):
+        vy = F64(0.0)
+    if j > ng - bound - 1 and vy > F64(0.0):
+        vy = F64(0.0)
+    gv[gi] = wp.vec2d(vx, vy)
+
+
+@wp.kernel
+def ref_mpm_g2p(gv: wp.array(dtype=wp.vec2d), pres: wp.array(dtype=F64), ng: int, inv_dx: F64, dt: F64, lo: F64,
+                hi: F64, x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), C: wp.array(dtype=wp.mat22d),
+                J: wp.array(dtype=F64), e: wp.array(dtype=F64)):
+    """Velocity and affine matrix from the 3 × 3 nodes, motion (clamped to the box), J and the pdV energy."""
+    p = wp.tid()
+    X = x[p] * inv_dx
+    b0 = int(wp.floor(X[0] - F64(0.5)))
+    b1 = int(wp.floor(X[1] - F64(0.5)))
+    fx0 = X[0] - F64(b0)
+    fx1 = X[1] - F64(b1)
+    w0 = ref_weights(fx0)
+    w1 = ref_weights(fx1)
+    nv = wp.vec2d()
+    c00 = F64(0.0)
+    c01 = F64(0.0)
+    c10 = F64(0.0)
+    c11 = F64(0.0)
+    di = F64(0.0)                  # the node offsets i, j as floats (F64(i) would retype the loop's int)
+    for i in range(3):
+        dpx = di - fx0
+        dj = F64(0.0)
+        for j in range(3):
+            dpy = dj - fx1
+            wt = w0[i] * w1[j]
+            u = gv[(b0 + i) * ng + (b1 + j)]
+            nv = nv + wt * u
+            sc = F64(4.0) * inv_dx * wt
+            c00 += sc * u[0] * dpx
+            c01 += sc * u[0] * dpy
+            c10 += sc * u[1] * dpx
+            c11 += sc * u[1] * dpy
+            dj += F64(1.0)
+        di += F64(1.0)
+    v[p] = nv
+    xp = x[p]
+    x[p] = wp.vec2d(wp.min(wp.max(xp[0] + dt * nv[0], lo), hi), wp.min(wp.max(xp[1] + dt * nv[1], lo), hi))
+    Jo = J[p]
+    Jn = Jo * (F64(1.0) + dt * (c00 + c11))
+    e[p] = e[p] - pres[p] * (Jn - Jo)
+    J[p] = Jn
+    C[p] = wp.mat22d(c00, c01, c10, c11)
+
+
+class MPMPort:
+    """The reference's MPM problem (``common.mpm_init(N)``) on a Warp device, float64, one P2G and one G2P a step."""
+
+    def __init__(self, common, n: int, device: str = "cpu"):
+        c, d = common.MPM, common.mpm_init(n)
+        self.device, self.n, self.common = device, n, common
+        as64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)      # noqa: E731
+        self.init = {k: as64(d[k]) for k in ("x", "v", "C", "J", "e")}
+        self.x = wp.array(self.init["x"], dtype=wp.vec2d, device=device)
+        self.v = wp.array(self.init["v"], dtype=wp.vec2d, device=device)
+        self.C = wp.array(self.init["C"], dtype=wp.mat22d, device=device)
+        self.J = wp.array(self.init["J"], dtype=F64, device=device)
+        self.e = wp.array(self.init["e"], dtype=F64, device=device)
+        self.ng = int(c["n_grid"])
+        self.pres = wp.zeros(n, dtype=F64, device=device)
+        self.grid = wp.zeros(self.ng * self.ng, dtype=wp.vec3d, device=device)
+        self.gv = wp.zeros(self.ng * self.ng, dtype=wp.vec2d, device=device)
+        self.gm = wp.zeros(self.ng * self.ng, dtype=F64, device=device)
+        # the constants as the C++ f64 build computes them
+        self.dx, self.inv_dx, self.dt = 1.0 / 512, 512.0, 1e-4
+        p_vol = (self.dx * 0.5) * (self.dx * 0.5)
+        self.p_mass = p_vol * 1.0
+        self.stress_k = self.dt * 4.0 * self.inv_dx * self.inv_dx * p_vol
+        self.jwl = (371.2 * 0.05, 3.231 * 0.05, 4.15, 0.95, 0.30)
+        self.bound = int(c["bound"])
+
+    def reset(self) -> None:
+        for k in ("x", "v", "C", "J", "e"):
+            getattr(self, k).assign(self.init[k])
+
+    def step(self) -> None:
+        dev, n, ng = self.device, self.n, self.ng
+        wp.launch(ref_mpm_p2g, n, inputs=[self.x, self.v, self.C, self.J, self.e, ng, F64(self.inv_dx), F64(self.dx),
+                                          F64(self.stress_k), F64(self.p_mass), *(F64(a) for a in self.jwl)],
+                  outputs=[self.pres, self.grid], device=dev)
+        wp.launch(ref_mpm_grid, ng * ng, inputs=[self.grid, ng, self.bound], outputs=[self.gv, self.gm], device=dev)
+        wp.launch(ref_mpm_g2p, n, inputs=[self.gv, self.pres, ng, F64(self.inv_dx), F64(self.dt), F64(2.0 * self.dx),
+                                          F64(1.0 - 2.0 * self.dx)],
+                  outputs=[self.x, self.v, self.C, self.J, self.e], device=dev)
+
+    def checks(self) -> dict:
+        return self.common.mpm_checks(self.x.numpy(), self.v.numpy(), self.C.numpy(), self.J.numpy(), self.e.numpy(),
+                                      float(self.gm.numpy().sum()))
+
+
 class Port:
     """The reference's CDEM problem on a Warp device, from the float32 initial state of ``common.cdem_init()``."""
 
@@ -206,6 +379,46 @@ def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> d
             "checks_max_rel_diff": max(rel.values()), "device": device}
 
 
+def run_mpm(ref_dir: Path, n: int = 100_000, reps: int = 5, device: str = "cpu") -> dict:
+    """The MPM port timed as the C++ program times its ``mpm n`` (reset, 20 steps, median over ``reps``), its state
+    after the first repetition checked against the C++ f64 run's (one thread, SCATTER=private)."""
+    from blastfrac._warp import init_warp
+
+    init_warp()
+    sys.path.insert(0, str(ref_dir))
+    try:
+        import common
+    finally:
+        sys.path.pop(0)
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": "private", "REPS": str(reps)}
+    r = subprocess.run(["./bench_cpp_f64", "mpm", str(n)], cwd=ref_dir, env=env, capture_output=True, text=True,
+                       check=True)
+    cpp = json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
+    steps = int(cpp["nsteps"])
+    p = MPMPort(common, n, device)
+    p.reset()
+    p.step()                                   # load the module
+    wp.synchronize_device(device)
+    walls, chk = [], None
+    for k in range(reps):
+        p.reset()
+        wp.synchronize_device(device)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            p.step()
+        wp.synchronize_device(device)
+        walls.append(time.perf_counter() - t0)
+        if k == 0:
+            chk = p.checks()
+    step_s = float(np.median(walls)) / steps
+    ref = cpp["checks"]
+    rel = {k: abs(chk[k] - ref[k]) / max(abs(ref[k]), 1e-300) for k in chk}
+    return {"particles": n, "port_step_ms": 1e3 * step_s, "port_units_steps_per_s": n / step_s,
+            "cpp_step_ms": cpp["step_ms_median"], "cpp_units_steps_per_s": cpp["units_steps_per_s"],
+            "port_over_cpp": step_s * 1e3 / cpp["step_ms_median"], "checks": chk, "cpp_checks": ref,
+            "checks_max_rel_diff": max(rel.values()), "device": device}
+
+
 def build(src: Path) -> Path:
     """A built scratch copy of the reference folder ``src`` (build.sh: g++ -O3 -march=native, data files)."""
     dst = Path(tempfile.mkdtemp(prefix="bench_ref_")) / "ref"
@@ -224,11 +437,16 @@ def main(argv=None) -> None:
     d = build(a.reference)
     try:
         r = run(d, a.steps, a.reps, a.device)
+        rm = [run_mpm(d, n, a.reps, a.device) for n in (100_000, 400_000)]
     finally:
         shutil.rmtree(d.parent, ignore_errors=True)
-    print(f"{r['triangles']:,} triangles: Warp port {r['port_step_ms']:.2f} ms/step, C++ f64 1 thread "
+    print(f"CDEM {r['triangles']:,} triangles: Warp port {r['port_step_ms']:.2f} ms/step, C++ f64 1 thread "
           f"{r['cpp_step_ms']:.2f} ms/step, port / C++ = {r['port_over_cpp']:.2f}; checks agree to "
           f"{r['checks_max_rel_diff']:.1e} (relative)")
+    for m in rm:
+        print(f"MPM {m['particles']:,} particles: Warp port {m['port_step_ms']:.2f} ms/step, C++ f64 1 thread "
+              f"{m['cpp_step_ms']:.2f} ms/step, port / C++ = {m['port_over_cpp']:.2f}; checks agree to "
+              f"{m['checks_max_rel_diff']:.1e} (relative)")
 
 
 if __name__ == "__main__":
