@@ -30,7 +30,7 @@ STATE_ARRAYS = ("x", "v", "f", "sigma", "pair_F", "pair_force", "pair_str", "pai
                 "pair_tbreak", "pair_inelastic", "pair_efrac", "pair_damp", "elem_damp", "elem_absorbed", "ledge_fprev",
                 "pulse_values",
                 "energy_acc")
-CONTACT_ARRAYS = ("contact_slot", "contact_fs", "contact_d0", "contact_p", "contact_kc", "elem_near", "query_after",
+CONTACT_ARRAYS = ("contact_slot", "contact_state", "elem_near", "query_after",
                   "loss_acc")
 
 

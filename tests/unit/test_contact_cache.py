@@ -15,7 +15,7 @@ from blastfrac.cdem.solver import CDEMSolver
 from blastfrac.model.builder import ModelBuilder
 from conftest import scenario
 
-HISTORY = ("contact_slot", "contact_fs", "contact_d0", "contact_p", "contact_kc", "elem_near", "query_after",
+HISTORY = ("contact_slot", "contact_state", "elem_near", "query_after",
            "loss_acc")
 
 

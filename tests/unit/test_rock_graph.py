@@ -78,7 +78,7 @@ def test_captured_steps_with_block_contact_are_bit_identical(tmp_path):
         if k % 100 == 99:
             _same(ref, cap)
     _same(ref, cap)
-    for name in ("contact_slot", "contact_fs", "contact_d0", "contact_p", "contact_kc", "loss_acc", "elem_near",
+    for name in ("contact_slot", "contact_state", "loss_acc", "elem_near",
                  "query_after", "fan_count", "node_flag"):
         assert np.array_equal(getattr(ref.cdem.contact, name).numpy(), getattr(cap.cdem.contact, name).numpy()), name
     c = cap.cdem.contact

@@ -137,7 +137,7 @@ from .contact_fan import (
     refresh_fan_cache,
     select_contact_nodes,
 )
-from .contact_geometry import FAN_CACHE, LOSS_PENALTY, LOSS_SLIP
+from .contact_geometry import FAN_CACHE, HIST_FS, HIST_KC, HIST_P, LOSS_PENALTY, LOSS_SLIP
 from .contact_hash import (
     compute_edge_samples,
     compute_sample_cells,
@@ -217,10 +217,8 @@ class BlockContact:
             raise ValueError(f"a mesh vertex is shared by {fan.max() + 1} triangles; block contact allows 63")
         self.fan_index = wp.array(fan.astype(np.int32), dtype=wp.int32, device=d)
         self.contact_slot = wp.full(n, -1, dtype=wp.int32, device=d)
-        self.contact_fs = wp.zeros(n, dtype=wp.float64, device=d)
-        self.contact_d0 = wp.zeros(n, dtype=wp.float64, device=d)     # overlap allowance [m]
-        self.contact_p = wp.zeros(n, dtype=wp.float64, device=d)      # overlap the penalty acts on [m]
-        self.contact_kc = wp.zeros(n, dtype=wp.float64, device=d)     # penalty stiffness in use [N/m per m]
+        # per node (Fs [N/m], d0 [m] overlap allowance, p [m] overlap the penalty acts on, Kc [N/m per m]); HIST_*
+        self.contact_state = wp.zeros(n, dtype=wp.vec4d, device=d)
         self.loss_acc = wp.zeros(2, dtype=wp.float64, device=d)       # LOSS_SLIP, LOSS_PENALTY [J/m]
         # on from the start: a node with no exposed edge costs one test, so an unbroken model pays little
         self.active = True
@@ -325,8 +323,7 @@ class BlockContact:
                   "sample_pos", "sorted_code"):
             setattr(marks, k, getattr(self, k))
         hist = self.s_hist = ContactHistory()
-        hist.slot, hist.fs, hist.d0, hist.p, hist.kc = (self.contact_slot, self.contact_fs, self.contact_d0,
-                                                        self.contact_p, self.contact_kc)
+        hist.slot, hist.state = self.contact_slot, self.contact_state
         hist.loss_acc = self.loss_acc
         self.s_prm = ContactParams()
         self._prm_values = None
@@ -508,9 +505,10 @@ class BlockContact:
     # ------------------------------------------------------------------ diagnostics (host side, not per step)
     def stored_energy(self) -> float:
         """Energy held by the active contacts, Σ ½Kc·p² + ½Fs²/Kc [J/m] (not in rock_energies' terms)."""
-        kc = self.contact_kc.numpy()
+        h = self.contact_state.numpy()
+        kc = h[:, HIST_KC]
         on = (self.contact_slot.numpy() >= 0) & (kc > 0.0)
-        p, fs = self.contact_p.numpy()[on], self.contact_fs.numpy()[on]
+        p, fs = h[on, HIST_P], h[on, HIST_FS]
         return float(np.sum(0.5 * kc[on] * p * p + 0.5 * fs * fs / kc[on]))
 
     def losses(self) -> dict[str, float]:

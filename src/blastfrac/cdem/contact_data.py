@@ -73,10 +73,9 @@ class ContactHistory:
     """Each node's contact: its edge, friction force, overlap allowance, overlap and stiffness; the losses."""
 
     slot: wp.array(dtype=wp.int32)            # contact edge slot, −1 none
-    fs: wp.array(dtype=wp.float64)            # tangential force [N/m]
-    d0: wp.array(dtype=wp.float64)            # overlap allowance [m]
-    p: wp.array(dtype=wp.float64)             # overlap the penalty acts on [m]
-    kc: wp.array(dtype=wp.float64)            # penalty stiffness in use [N/m per m]
+    state: wp.array(dtype=wp.vec4d)           # (Fs [N/m] tangential force, d0 [m] overlap allowance, p [m] overlap
+                                              # the penalty acts on, Kc [N/m per m] penalty stiffness in use): one
+                                              # record, so that a node's history is one load (the pass is latency-bound)
     loss_acc: wp.array(dtype=wp.float64)      # LOSS_SLIP, LOSS_PENALTY [J/m]
 
 

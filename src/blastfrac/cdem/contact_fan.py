@@ -72,15 +72,16 @@ def corner_consider(
     x: wp.array(dtype=wp.vec2d), slot_iface: wp.array(dtype=wp.int32), pair_mode: wp.array(dtype=wp.int32),
     st: vec5d, max_depth: wp.float64, touch_tol: wp.float64,
 ):
-    """consider_edge for the exposed edges of other's element at the vertex (a node inside that corner)."""
+    """consider_edge for the exposed edges of other's element at the vertex (a node inside that corner); ex1, ex2:
+    whether its edges 'other' and the one ending at 'other' are exposed, which each is the other's corner edge."""
     sb = slot_prev(other)
     xc = x[other]
     out = st
     if ex1:
-        out = consider_edge(other, edge_coords(xn, xc, x[slot_end(other)]), sb, xn, u1, u2,
+        out = consider_edge(other, edge_coords(xn, xc, x[slot_end(other)]), sb, wp.where(ex2, 1, 0), xn, u1, u2,
                             x, slot_iface, pair_mode, out, max_depth, touch_tol)
     if ex2:
-        out = consider_edge(sb, edge_coords(xn, x[sb], xc), other, xn, u1, u2, x,
+        out = consider_edge(sb, edge_coords(xn, x[sb], xc), other, wp.where(ex1, 1, 0), xn, u1, u2, x,
                             slot_iface, pair_mode, out, max_depth, touch_tol)
     return out
 

@@ -14,6 +14,8 @@ MAX_FAN = wp.constant(64)                     # bound on the pairs walked around
 KC_CAP = wp.constant(wp.float64(0.25))        # Kc ≤ KC_CAP·m_min/Δt²: ω_c·Δt ≤ 0.71, node against edge
 FAN_CACHE = wp.constant(8)                    # cached fan candidates of a node (≤ 4 seen in the demo; more: walk)
 
+HIST_FS, HIST_D0, HIST_P, HIST_KC = 0, 1, 2, 3   # BlockContact.contact_state columns: Fs, d0, p, Kc
+
 LOSS_SLIP = 0          # BlockContact.loss_acc slots: Coulomb slip work [J/m]
 LOSS_PENALTY = 1       # penalty and tangential elastic energy dropped when a contact ends or changes edge [J/m]
 
@@ -186,14 +188,15 @@ def coulomb_update(fs: wp.float64, kc: wp.float64, slip_rate: wp.float64, dt: wp
 
 @wp.func
 def consider_edge(
-    s: wp.int32, c: wp.vec3d, corner_other: wp.int32, xn: wp.vec2d, u1: wp.vec2d, u2: wp.vec2d,
-    x: wp.array(dtype=wp.vec2d), slot_iface: wp.array(dtype=wp.int32), pair_mode: wp.array(dtype=wp.int32),
-    st: vec5d, max_depth: wp.float64, touch_tol: wp.float64,
+    s: wp.int32, c: wp.vec3d, corner_other: wp.int32, corner_exposed: wp.int32, xn: wp.vec2d, u1: wp.vec2d,
+    u2: wp.vec2d, x: wp.array(dtype=wp.vec2d), slot_iface: wp.array(dtype=wp.int32),
+    pair_mode: wp.array(dtype=wp.int32), st: vec5d, max_depth: wp.float64, touch_tol: wp.float64,
 ):
     """Update the search state st = (best edge, its ξ, its g, distance to the nearest edge, 1 if the node is
     behind that nearest edge) with edge slot s, c = edge_coords of the node against it (module doc, "Which
     edge"). corner_other: −1, or for an edge ending at the node's own vertex, the other edge of its element
-    at that vertex."""
+    at that vertex; corner_exposed: 1 or 0 if the caller knows whether that edge is exposed (the fan cache's
+    codes do), −1 to look it up in the spring states."""
     zero = wp.float64(0.0)
     s_end = slot_end(s)
     on_edge = c[0] >= -XI_TOL and c[0] <= wp.float64(1.0) + XI_TOL
@@ -220,8 +223,12 @@ def consider_edge(
     else:
         # an edge touching the node at its end says nothing about the inside test unless the node is inside
         # that element's corner: behind this edge and behind the other exposed edge of the corner
-        if valid and slot_exposed(corner_other, slot_iface, pair_mode):
-            valid = edge_coords(xn, x[corner_other], x[slot_end(corner_other)])[1] <= touch_tol
+        if valid:
+            exposed = corner_exposed != 0
+            if corner_exposed < 0:
+                exposed = slot_exposed(corner_other, slot_iface, pair_mode)
+            if exposed:
+                valid = edge_coords(xn, x[corner_other], x[slot_end(corner_other)])[1] <= touch_tol
         if valid and dist < near_d:
             near_d = dist
             near_inside = wp.float64(1.0)

@@ -218,7 +218,7 @@ def hash_edge(
     out = sr
     if not skip:
         c = edge_coords(xn, x[s], x[s_end])
-        st = consider_edge(s, c, corner, xn, u1, u2, x, mesh.slot_iface, pair_mode,
+        st = consider_edge(s, c, corner, -1, xn, u1, u2, x, mesh.slot_iface, pair_mode,
                            vec5d(sr[0], sr[1], sr[2], sr[3], sr[4]), prm.max_depth, prm.touch_tol)
         out = vec6d(st[0], st[1], st[2], st[3], st[4], wp.min(sr[5], c[2]))
         if is_open and c[2] < prm.wake_dist:

@@ -46,9 +46,11 @@ def contact_force(
     best = int(st[0])
     near_inside = st[4] > zero
     prev = hist.slot[n]
-    p_prev = hist.p[n]
-    kc_prev = hist.kc[n]
-    fs_prev = hist.fs[n]
+    h = hist.state[n]                             # (Fs, d0, p, Kc) of the last step: one load
+    fs_prev = h[0]
+    d0_prev = h[1]
+    p_prev = h[2]
+    kc_prev = h[3]
     found = best >= 0 and near_inside
     # history: 0 new contact, 1 same edge as the last step, 2 another edge, 3 lost (last step's edge, p > 0)
     history = wp.int32(0)
@@ -67,10 +69,7 @@ def contact_force(
             wp.atomic_add(energy_acc, CONTACT_DISSIPATED, lost0)
             wp.atomic_add(hist.loss_acc, LOSS_PENALTY, lost0)
         hist.slot[n] = -1
-        hist.fs[n] = zero
-        hist.d0[n] = zero
-        hist.p[n] = zero
-        hist.kc[n] = zero
+        hist.state[n] = wp.vec4d()
         return
     ia = edge
     ib = slot_end(edge)
@@ -92,7 +91,7 @@ def contact_force(
     p = zero
     d0 = zero
     if history == 3 or history == 1:
-        p_raw = pen - hist.d0[n]
+        p_raw = pen - d0_prev
         if p_raw < zero and p_prev > zero:        # separation within the step: release force (module doc)
             q = release_overlap(p_prev, p_raw)
             fn = kc_prev * q
@@ -106,14 +105,14 @@ def contact_force(
         if history == 3:
             keep = False
         elif p_raw >= zero or p_prev == zero:     # ordinary contact on the same edge (or resting at p = 0)
-            ov = penalty_overlap(1, pen, hist.d0[n], p_prev, kc_prev, kc)
+            ov = penalty_overlap(1, pen, d0_prev, p_prev, kc_prev, kc)
             p = ov[0]
             d0 = ov[1]
             lost = ov[2]
             fs = fs_prev
             fn = kc * p
     else:
-        ov2 = penalty_overlap(history, pen, hist.d0[n], p_prev, kc_prev, kc)
+        ov2 = penalty_overlap(history, pen, d0_prev, p_prev, kc_prev, kc)
         p = ov2[0]
         d0 = ov2[1]
         lost = ov2[2]
@@ -140,16 +139,10 @@ def contact_force(
         fs = zero
     if keep:
         hist.slot[n] = edge
-        hist.fs[n] = fs
-        hist.d0[n] = d0
-        hist.p[n] = p
-        hist.kc[n] = kc
+        hist.state[n] = wp.vec4d(fs, d0, p, kc)
     else:
         hist.slot[n] = -1
-        hist.fs[n] = zero
-        hist.d0[n] = zero
-        hist.p[n] = zero
-        hist.kc[n] = zero
+        hist.state[n] = wp.vec4d()
     force = fn * n_hat + fs * t_hat
     wp.atomic_add(f, n, force)
     wp.atomic_add(f, ia, -(one - xi) * force)
@@ -190,7 +183,9 @@ def node_contact(
         return                                    # held broken faces not searched (BlockContact.held_faces)
     excl = wp.int64(0)
     if use_cache != 0:
-        excl = cache.fan_excl[n]
+        # the mask serves the hash search and a fan walk only: a held node with its fan cached leaves it unread
+        if is_open or woken or cache.fan_count[n] < 0:
+            excl = cache.fan_excl[n]
     else:
         excl = fan_exclusions(n, mesh.node_pairs, mesh.fan_index, mesh.pair_i, mesh.pair_j, pair_mode, pair_dropped)
     st = vec5d(wp.float64(-1.0), zero, zero, wp.float64(1.0e300), zero)
