@@ -127,6 +127,8 @@ def _target(sim, key: str):
         obj = obj[int(p)] if p.isdigit() else getattr(obj, p, None)
         if obj is None:
             return None
+    if not parts[-1].isdigit() and not hasattr(obj, parts[-1]):
+        return None                               # an attribute this version does not have (renamed or removed)
     return obj, parts[-1]
 
 
