@@ -67,12 +67,14 @@ def _restore_handlers(old: dict) -> None:
 
 
 def _restart_key(resolved: dict) -> str:
-    """The resolved scenario without what a restart may change (end time, step limit, progress, device, output)."""
+    """The resolved scenario without what a restart may change (end time, step limit, progress, device, threads,
+    output). The thread count changes no result (tests/unit/test_threads.py; the restart test resumes a two-thread
+    run on one)."""
     import json
 
     d = {k: v for k, v in resolved.items() if k != "output"}
     d["simulation"] = {k: v for k, v in d.get("simulation", {}).items()
-                       if k not in ("end_time", "max_steps", "progress", "device")}
+                       if k not in ("end_time", "max_steps", "progress", "device", "threads")}
     return json.dumps(d, sort_keys=True, default=str)
 
 

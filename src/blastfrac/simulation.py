@@ -445,7 +445,7 @@ class Simulation:
         arrays, meta = ckpt.read(path)
         if meta.get("scenario_hash") != ckpt.scenario_hash(_restart_key(resolved_dict(self.scenario))):
             raise ValueError(f"--restart {path}: the checkpoint was made from another scenario (only "
-                             "simulation.end_time, max_steps, progress, device and [output] may change)")
+                             "simulation.end_time, max_steps, progress, device, threads and [output] may change)")
         extra = {k: arrays.pop(k) for k in list(arrays) if k.startswith("snap")}
         ckpt.restore(self, arrays, meta["scalars"])
         run = meta["run"]
