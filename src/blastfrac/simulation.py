@@ -217,8 +217,8 @@ class Simulation:
             if self.crack_gas is not None:
                 self.crack_gas.add_loads(st)
             if self.cdem.splits("integrate", self.model.element_count):
-                self.cdem.integrate(st, dt, self.alpha)     # in two halves: the second thread is taken
-                self._gas_advance(dt)
+                # in two parts, the gas's advance before the second one in the second thread (balanced)
+                self.cdem.integrate(st, dt, self.alpha, beside=lambda: self._gas_advance(dt))
             else:
                 self._concurrently(lambda: self.cdem.integrate(st, dt, self.alpha), lambda: self._gas_advance(dt))
         else:

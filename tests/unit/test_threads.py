@@ -36,6 +36,8 @@ def test_two_threads_give_the_same_results_as_one(tmp_path):
         if sim._second is not None:
             sim._second.WINDOWS = 0                        # no timing trial: every step after the first uses both
         sim.run()
+        if n == 2:   # the integration ran in two parts beside the gas's advance, its split point moving (balanced)
+            assert sim.cdem._share.get("integrate", 0.5) != 0.5
         out[n] = {"x": sim.state.x.numpy(), "v": sim.state.v.numpy(), "mode": sim.state.pair_mode.numpy(),
                   "gas_x": sim.gas.x.numpy(), "gas_ie": sim.gas.ie.numpy(), "crack": sim.crack_gas.gas.mass.numpy(),
                   "ppv": sim.ppv.values(), "energy": sim.state.energy_acc.numpy(),
