@@ -1,4 +1,5 @@
-"""simulation.threads = 2 runs the gas stages beside the rock's in a second thread, and the springs in two halves:
+"""simulation.threads = 2 runs the gas stages beside the rock's in a second thread, and the springs (and the CST, the
+integration and block contact's pass) in two halves:
 the same arithmetic, so the same motion, spring states and energy accounts, bit for bit (a coupled blast with crack
 gas, cracking, dashpots and bulk viscosity: each spring and block keeps its own damping account, so no total is
 summed in another order by the second thread)."""
@@ -36,8 +37,9 @@ def test_two_threads_give_the_same_results_as_one(tmp_path):
         if sim._second is not None:
             sim._second.WINDOWS = 0                        # no timing trial: every step after the first uses both
         sim.run()
-        if n == 2:   # the integration ran in two parts beside the gas's advance, its split point moving (balanced)
+        if n == 2:   # the integration ran in two parts beside the gas's advance, its split point moving (balanced),
             assert sim.cdem._share.get("integrate", 0.5) != 0.5
+            assert sim.cdem.contact.passes_in_parts > 0     # and block contact's pass over its list in two halves
         out[n] = {"x": sim.state.x.numpy(), "v": sim.state.v.numpy(), "mode": sim.state.pair_mode.numpy(),
                   "gas_x": sim.gas.x.numpy(), "gas_ie": sim.gas.ie.numpy(), "crack": sim.crack_gas.gas.mass.numpy(),
                   "ppv": sim.ppv.values(), "energy": sim.state.energy_acc.numpy(),

@@ -98,7 +98,15 @@ end of the demo), so the pass works from caches that change only when a spring d
 - the hash is a cell grid of our own with the cells and the point order of wp.HashGrid (the same points met in the
   same order), each cell's points stored together with the exposure of their edge (kept by mark_pair_changes):
   a query reads memory in sequence and loads no spring state;
-- the kernels take their arrays as five Warp structs (``contact_data``: mesh, hash, caches, history, parameters)
+- the pass reads only the state of its start and writes per node (history, quiet window), so that its order does
+  not matter: the wakes of a pass go to ``wake_stamp`` and are copied into ``elem_near``, which the woken tests read,
+  after it (before 2026-12-06 a block re-woken earlier in a pass read as not woken for the nodes after: a wake
+  could switch a block off for one step, and the result depended on the list order). With two threads and a long
+  list (CDEMSolver stage "contact": from 1,500 listed nodes) the pass runs in two halves, each node's force and
+  energies kept in its record (``ContactRecords``), which ``apply_contact_records`` then adds in list order: the
+  sums of one pass in one thread, to the bit (tests/unit/test_threads.py). In one part the pass adds them at once;
+- the kernels take their arrays as six Warp structs (``contact_data``: mesh, hash, caches, history, parameters,
+  records)
   and the rock state's arrays, and the launches are recorded once and replayed (``_warp.Launcher``): packing the
   ~50 arrays of a launch cost more than a pass over the nodes of a small mesh.
 
@@ -127,7 +135,15 @@ import numpy as np
 import warp as wp
 
 from .._warp import Launcher
-from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMarks, ContactMesh, ContactParams
+from .contact_data import (
+    ContactCache,
+    ContactHash,
+    ContactHistory,
+    ContactMarks,
+    ContactMesh,
+    ContactParams,
+    ContactRecords,
+)
 from .contact_fan import (
     append_vertices,
     list_candidates,
@@ -146,7 +162,7 @@ from .contact_hash import (
     largest_displacement,
     rebuild_decision,
 )
-from .contact_kernels import eval_block_contact
+from .contact_kernels import apply_contact_records, eval_block_contact
 
 
 class BlockContact:
@@ -247,6 +263,8 @@ class BlockContact:
         # nodes then search the hash too, so a node of theirs cannot enter the open block unseen (module doc).
         self.near_window = 2 * self.rebuild_interval
         self.elem_near = wp.full(model.element_count, -(1 << 30), dtype=wp.int32, device=d)
+        # the wakes of the current pass (read from the next step on: elem_near is copied from it after each pass)
+        self.wake_stamp = wp.full(model.element_count, -(1 << 30), dtype=wp.int32, device=d)
         # An open node that found no exposed edge within h_min (and no contact) skips the search for
         # rebuild_interval steps: under the speed bound above nothing can close h_min in that time. On intact
         # rock this leaves the mesh-boundary nodes one search per rebuild instead of one per step.
@@ -292,6 +310,14 @@ class BlockContact:
         self._cache_fresh = False
         self._counts = wp.zeros(2, dtype=wp.int32, device=d)          # dirty vertices, listed nodes
         self._node_list = wp.zeros(n, dtype=wp.int32, device=d)       # the nodes of this step's contact pass
+        # what each listed node's contact adds to the rock (contact_data.ContactRecords), added in list order after
+        # the pass, which can then run in two parts (CDEMSolver._in_halves, stage "contact")
+        self.rec_nodes = wp.zeros(n, dtype=wp.vec3i, device=d)
+        self.rec_force = wp.zeros(n, dtype=wp.vec2d, device=d)
+        self.rec_xi = wp.zeros(n, dtype=wp.float64, device=d)
+        self.rec_energy = wp.zeros(n, dtype=wp.vec2d, device=d)
+        self._parts = False                                           # this step's pass ran in parts
+        self.passes_in_parts = 0                                      # how many passes have (a diagnostic)
         self._all_nodes = wp.array(np.arange(n, dtype=np.int32), dtype=wp.int32, device=d)   # without the cache
         self._counts_all = wp.array([0, n], dtype=wp.int32, device=d)
         self._cand_list = wp.zeros(n, dtype=wp.int32, device=d)       # list_candidates
@@ -315,8 +341,8 @@ class BlockContact:
         hsh.cell_starts, hsh.cell_ends, hsh.sorted_xy, hsh.sorted_code = (self.cell_starts, self.cell_ends,
                                                                           self.sorted_xy, self.sorted_code)
         cache = self.s_cache = ContactCache()
-        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "query_after",
-                  "new_nodes", "new_count"):
+        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "wake_stamp",
+                  "query_after", "new_nodes", "new_count"):
             setattr(cache, k, getattr(self, k))
         marks = self.s_marks = ContactMarks()
         for k in ("pair_vertex", "seen_mode", "seen_dropped", "vertex_stamp", "iface_slots", "slot_samples",
@@ -325,6 +351,8 @@ class BlockContact:
         hist = self.s_hist = ContactHistory()
         hist.slot, hist.state = self.contact_slot, self.contact_state
         hist.loss_acc = self.loss_acc
+        rec = self.s_rec = ContactRecords()
+        rec.nodes, rec.force, rec.xi, rec.energy = self.rec_nodes, self.rec_force, self.rec_xi, self.rec_energy
         self.s_prm = ContactParams()
         self._prm_values = None
 
@@ -400,11 +428,15 @@ class BlockContact:
                          [self._cand_list, self._cand_count, stride, state.x, prm, self._clock, self.s_cache,
                           self.contact_slot, self._counts, self._node_list])
             node_list, counts = self._node_list, self._counts
-        dim, stride = self._lanes(n)
-        self._launch(eval_block_contact, dim,
-                     [node_list, counts, stride, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist, prm,
-                      state.pair_mode, state.pair_dropped, state.x, state.v, self._clock, float(dt), state.f,
-                      state.energy_acc])
+        # the pass over the list, in two parts on two threads where the list is long (its length is read on a CPU
+        # only, where that costs nothing), then its records added in list order and its wakes made visible
+        listed = int(counts.numpy()[1]) if self._cpu and self.in_halves is not None else 0
+        self._parts = False
+        self._halves("contact", listed, self._eval, state, node_list, counts, use_cache, prm, dt)
+        if self._parts:
+            self._launch(apply_contact_records, 1, [counts, self.s_rec, state.f, state.energy_acc, self.loss_acc, 1])
+            self.passes_in_parts += 1
+        wp.copy(self.elem_near, self.wake_stamp)
 
     def rescan_springs(self) -> None:
         """The spring states (pair_mode, pair_dropped) were changed outside the spring kernel, which lists the
@@ -432,6 +464,18 @@ class BlockContact:
                       self._counts_b if second else self._counts, self._dirty_b if second else self._dirty_vertices],
                      key=key)
         self._b_listed = self._b_listed or second        # joined by append_vertices once both halves have run
+
+    def _eval(self, state, node_list, counts, use_cache, prm, dt, first: int = 0, count: int | None = None,
+              key=None) -> None:
+        """eval_block_contact over the list; called by in_halves with first/count (stand-ins: the list's length is
+        on the device), over its first half (first = 0) or its second."""
+        part = 0 if count is None else (1 if first == 0 else 2)
+        self._parts = self._parts or part != 0       # then apply_contact_records adds the parts' records
+        dim, stride = self._lanes(self.model.node_count)
+        self._launch(eval_block_contact, dim,
+                     [node_list, counts, part, stride, use_cache, self.s_mesh, self.s_hash, self.s_cache, self.s_hist,
+                      prm, state.pair_mode, state.pair_dropped, state.x, state.v, self._clock, float(dt), self.s_rec,
+                      state.f, state.energy_acc], key=key)
 
     def _largest_displacement(self, state, first: int = 0, count: int | None = None, key=None) -> None:
         """largest_displacement over nodes first … first + count − 1, into _moved[0] (first half) or _moved[1]."""

@@ -47,7 +47,9 @@ class ContactCache:
     fan_excl: wp.array(dtype=wp.int64)        # fan_exclusions mask
     fan_cand: wp.array2d(dtype=wp.int32)      # fan candidates, 4·node + exposure bits
     fan_count: wp.array(dtype=wp.int32)       # −1: not cached, walk the fan
-    elem_near: wp.array(dtype=wp.int32)       # step at which an open face last came near each element
+    elem_near: wp.array(dtype=wp.int32)       # step at which an open face last came near each element, as of the
+                                              # start of this pass (read-only in the pass: its order does not matter)
+    wake_stamp: wp.array(dtype=wp.int32)      # the same, written in the pass (BlockContact.apply copies it over)
     query_after: wp.array(dtype=wp.int32)     # first step an open node searches the hash again
     new_nodes: wp.array(dtype=wp.int32)       # the nodes whose flag a refresh turned from 0 (merge_candidates)
     new_count: wp.array(dtype=wp.int32)       # [1]: how many
@@ -92,3 +94,15 @@ class ContactParams:
     near_window: wp.int32                     # steps a woken block stays woken
     quiet_steps: wp.int32                     # steps an open node with nothing near skips the hash
     held_faces: wp.int32                      # 1: held broken faces search their fan
+
+
+@wp.struct
+class ContactRecords:
+    """What the contact of the i-th listed node adds to the rock, kept per list item instead of added at once, so
+    that the pass can run in parts on two threads and ``apply_contact_records`` adds it all in list order (the
+    sums of one pass over the list, to the bit)."""
+
+    nodes: wp.array(dtype=wp.vec3i)           # (node, edge start, edge end); node −1: no force
+    force: wp.array(dtype=wp.vec2d)           # contact force on the node [N/m]
+    xi: wp.array(dtype=wp.float64)            # where it acts on the edge [-] (reactions (1 − ξ, ξ))
+    energy: wp.array(dtype=wp.vec2d)          # (penalty energy dropped, slip work) [J/m]

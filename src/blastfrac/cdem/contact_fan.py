@@ -155,7 +155,7 @@ def held_search(
     candidates (fan_cache_build: the same nodes in the same order, so the same result); otherwise, or if the fan
     overflowed the cache, by walking the vertex's node list.
 
-    With ``wake`` (an open node) it also wakes (elem_near) the blocks of the fan whose other two nodes come
+    With ``wake`` (an open node) it also wakes (wake_stamp) the blocks of the fan whose other two nodes come
     within wake_dist of n's element edges at the vertex: those nodes could enter n's block through an edge that
     is not at their own vertex, which their fan search does not see (cdem/contact.py, "Cost"). The edges that
     end at the vertex itself touch n there and say nothing about that, so they wake no block."""
@@ -181,7 +181,7 @@ def held_search(
             ex2 = (code & 2) != 0
             if wake:
                 if far_nodes_near(other, xa, xn, xb, x, prm.wake_dist):
-                    cache.elem_near[other // 3] = step
+                    cache.wake_stamp[other // 3] = step
             if corner_inside(xn, other, ex1, ex2, x, touch_tol):
                 if not have_u:
                     u1 = wp.normalize(x[slot_end(n)] - xn)
@@ -201,7 +201,7 @@ def held_search(
                     # test first, the full evaluation for the few that pass
                     if wake and (ex1 or ex2):
                         if far_nodes_near(other, xa, xn, xb, x, prm.wake_dist):
-                            cache.elem_near[other // 3] = step
+                            cache.wake_stamp[other // 3] = step
                     if ex1 or ex2:
                         if corner_inside(xn, other, ex1, ex2, x, touch_tol):
                             if not have_u:
@@ -320,8 +320,9 @@ def node_faces(
 
 @wp.func
 def node_woken(e: wp.int32, elem_near: wp.array(dtype=wp.int32), step: wp.int32, near_window: wp.int32):
-    """True if an open face came near element e in the last near_window steps. Flags set in this step are not
-    read until the next one (a block woken again earlier in this step's pass reads as not woken)."""
+    """True if an open face came near element e in the near_window steps before this one. The wakes of this step's
+    pass go to wake_stamp and are read from the next step on (elem_near is their copy as of the start of the pass),
+    so a node's woken state does not depend on where it stands in the pass."""
     return elem_near[e] >= step - near_window and elem_near[e] < step
 
 

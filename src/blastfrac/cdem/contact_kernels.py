@@ -6,7 +6,7 @@ from __future__ import annotations
 import warp as wp
 
 from ..model.model import CONTACT_DISSIPATED
-from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh, ContactParams
+from .contact_data import ContactCache, ContactHash, ContactHistory, ContactMesh, ContactParams, ContactRecords
 from .contact_fan import held_search, node_faces, node_woken
 from .contact_geometry import (
     KC_CAP,
@@ -24,6 +24,40 @@ from .contact_hash import hash_search
 
 
 @wp.func
+def add_contact(n: wp.int32, ia: wp.int32, ib: wp.int32, force: wp.vec2d, xi: wp.float64, pen: wp.float64,
+                slip: wp.float64, f: wp.array(dtype=wp.vec2d), energy_acc: wp.array(dtype=wp.float64),
+                loss_acc: wp.array(dtype=wp.float64)):
+    """Add a node's contact force to it (n ≥ 0) and the reactions (1 − ξ, ξ) to the edge's nodes ia, ib (linear
+    momentum is conserved to round-off), and the penalty energy dropped and the slip work [J/m] (where not 0)."""
+    if n >= 0:
+        wp.atomic_add(f, n, force)
+        wp.atomic_add(f, ia, -(wp.float64(1.0) - xi) * force)
+        wp.atomic_add(f, ib, -xi * force)
+    if pen != wp.float64(0.0):
+        wp.atomic_add(energy_acc, CONTACT_DISSIPATED, pen)
+        wp.atomic_add(loss_acc, LOSS_PENALTY, pen)
+    if slip != wp.float64(0.0):
+        wp.atomic_add(energy_acc, CONTACT_DISSIPATED, slip)
+        wp.atomic_add(loss_acc, LOSS_SLIP, slip)
+
+
+@wp.func
+def record_contact(n: wp.int32, ia: wp.int32, ib: wp.int32, force: wp.vec2d, xi: wp.float64, pen: wp.float64,
+                   slip: wp.float64, item: wp.int32, rec: ContactRecords, f: wp.array(dtype=wp.vec2d),
+                   energy_acc: wp.array(dtype=wp.float64), loss_acc: wp.array(dtype=wp.float64)):
+    """A node's contact (add_contact's arguments; n −1: no force): added now (item < 0, one pass over the list in
+    one thread, or a GPU), or kept in record item for apply_contact_records (a pass in two parts). The rock's forces
+    and energies are not read in the pass, so both add the same terms in the same order: the same sums."""
+    if item < 0:
+        add_contact(n, ia, ib, force, xi, pen, slip, f, energy_acc, loss_acc)
+    else:
+        rec.nodes[item] = wp.vec3i(n, ia, ib)
+        rec.force[item] = force
+        rec.xi[item] = xi
+        rec.energy[item] = wp.vec2d(pen, slip)
+
+
+@wp.func
 def contact_force(
     n: wp.int32,
     trib: wp.float64,
@@ -34,11 +68,15 @@ def contact_force(
     v: wp.array(dtype=wp.vec2d),
     dt: wp.float64,
     hist: ContactHistory,
+    item: wp.int32,
+    rec: ContactRecords,
     f: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
-    """Contact forces of candidate node n (trib: its tributary length [m]) from its search state st
-    (hash_search or held_search) and its contact history; see the module doc."""
+    """Contact force of candidate node n (trib: its tributary length [m]) from its search state st (hash_search or
+    held_search) and its contact history (see the module doc), added to f and the energy accounts, or with item ≥ 0
+    kept in record ``item`` of rec (the force, where it acts, the energies dropped) for apply_contact_records to add
+    (record_contact)."""
     zero = wp.float64(0.0)
     one = wp.float64(1.0)
     half = wp.float64(0.5)
@@ -65,9 +103,8 @@ def contact_force(
         edge = prev
     else:
         if prev >= 0:                             # contact ends at zero overlap: only its friction spring is dropped
-            lost0 = half * fs_prev * fs_prev / kc_prev
-            wp.atomic_add(energy_acc, CONTACT_DISSIPATED, lost0)
-            wp.atomic_add(hist.loss_acc, LOSS_PENALTY, lost0)
+            record_contact(n, -1, -1, wp.vec2d(), zero, half * fs_prev * fs_prev / kc_prev, zero, item, rec, f,
+                           energy_acc, hist.loss_acc)
         hist.slot[n] = -1
         hist.state[n] = wp.vec4d()
         return
@@ -119,22 +156,18 @@ def contact_force(
         if history == 2:
             lost = lost + half * fs_prev * fs_prev / kc_prev      # friction history reset on a new edge
         fn = kc * p
-    if lost > zero:
-        wp.atomic_add(energy_acc, CONTACT_DISSIPATED, lost)
-        wp.atomic_add(hist.loss_acc, LOSS_PENALTY, lost)
+    pen_lost = wp.max(lost, zero)                 # (only a positive loss is booked)
+    slip = zero
     vt = wp.dot(v[n] - ((one - xi) * v[ia] + xi * v[ib]), t_hat)
     if fn > zero:
         cu = coulomb_update(fs, kc, vt, dt, prm.mu_f * fn)
         fs = cu[0]
-        if cu[1] > zero:
-            wp.atomic_add(energy_acc, CONTACT_DISSIPATED, cu[1])
-            wp.atomic_add(hist.loss_acc, LOSS_SLIP, cu[1])
+        slip = wp.max(cu[1], zero)
     elif released:
         # the same first-order correction of the last step's tangential impulse (|Fs| ≤ μ|Fn| still holds);
         # its work is taken off the slip loss booked in the steps before
         fs = fs_release
-        wp.atomic_add(energy_acc, CONTACT_DISSIPATED, -fs * vt * dt)
-        wp.atomic_add(hist.loss_acc, LOSS_SLIP, -fs * vt * dt)
+        slip = -fs * vt * dt
     else:
         fs = zero
     if keep:
@@ -143,10 +176,7 @@ def contact_force(
     else:
         hist.slot[n] = -1
         hist.state[n] = wp.vec4d()
-    force = fn * n_hat + fs * t_hat
-    wp.atomic_add(f, n, force)
-    wp.atomic_add(f, ia, -(one - xi) * force)
-    wp.atomic_add(f, ib, -xi * force)
+    record_contact(n, ia, ib, fn * n_hat + fs * t_hat, xi, pen_lost, slip, item, rec, f, energy_acc, hist.loss_acc)
 
 
 
@@ -165,10 +195,12 @@ def node_contact(
     v: wp.array(dtype=wp.vec2d),
     step: wp.int32,
     dt: wp.float64,
+    item: wp.int32,
+    rec: ContactRecords,
     f: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
-    """The contact of node n at this step (its search, then contact_force)."""
+    """The contact of node n at this step (its search, then contact_force; item: contact_force's)."""
     zero = wp.float64(0.0)
     nf = wp.vec2d()
     if use_cache != 0:
@@ -205,13 +237,14 @@ def node_contact(
         # nothing found and no contact to end: contact_force would only rewrite the zeros of a node without one
         if st[0] < zero and hist.slot[n] < 0:
             return
-    contact_force(n, nf[0], st, mesh, prm, x, v, dt, hist, f, energy_acc)
+    contact_force(n, nf[0], st, mesh, prm, x, v, dt, hist, item, rec, f, energy_acc)
 
 
 @wp.kernel
 def eval_block_contact(
     node_list: wp.array(dtype=wp.int32),
     counts: wp.array(dtype=wp.int32),
+    part: wp.int32,
     stride: wp.int32,
     use_cache: wp.int32,
     mesh: ContactMesh,
@@ -225,17 +258,50 @@ def eval_block_contact(
     v: wp.array(dtype=wp.vec2d),
     clock: wp.array(dtype=wp.int32),
     dt: wp.float64,
+    rec: ContactRecords,
     f: wp.array(dtype=wp.vec2d),
     energy_acc: wp.array(dtype=wp.float64),
 ):
-    """Contact of each listed node (select_contact_nodes, counts[1] of them). The tests that listed it are made
-    again here, in list order, so that the result is that of one pass over every node in node order (a node's
-    woken flag can turn off in the pass). Thread i takes items i, i + stride, ...: one thread on a CPU (the list
-    in order, whatever its length, and no per-thread copy of the structs for the items past its end), one item
-    per thread on a GPU."""
-    i = wp.tid()
+    """Contact of each listed node (select_contact_nodes, counts[1] of them), added to f and energy_acc. The tests
+    that listed it are made again here. Thread i takes items i, i + stride, ...: one thread on a CPU (the list in
+    order, whatever its length, and no per-thread copy of the structs for the items past its end), one item per
+    thread on a GPU.
+
+    part: 0 the whole list, 1 its first half, 2 its second half (two threads on a CPU; each item then goes into its
+    record, which apply_contact_records adds in list order once both halves have run). A node reads the state of the
+    pass's start only (positions, velocities, spring states, caches; the wakes of this pass go to wake_stamp) and
+    writes its own history, query window and record, so the halves are independent, and the sums are those of one
+    pass in list order."""
+    n = counts[1]
+    lo = wp.int32(0)
+    hi = n
+    if part == 1:
+        hi = n / 2
+    elif part == 2:
+        lo = n / 2
+    i = lo + wp.tid()
     step = clock[0]
-    while i < counts[1]:
+    while i < hi:
+        item = wp.int32(-1)
+        if part != 0:
+            item = i
+            rec.nodes[i] = wp.vec3i(-1, -1, -1)  # nothing to add unless contact_force says otherwise
+            rec.energy[i] = wp.vec2d()
         node_contact(node_list[i], use_cache, mesh, hsh, cache, hist, prm, pair_mode, pair_dropped, x, v, step, dt,
-                     f, energy_acc)
+                     item, rec, f, energy_acc)
+        i += stride
+
+
+@wp.kernel
+def apply_contact_records(counts: wp.array(dtype=wp.int32), rec: ContactRecords, f: wp.array(dtype=wp.vec2d),
+                          energy_acc: wp.array(dtype=wp.float64), loss_acc: wp.array(dtype=wp.float64),
+                          stride: wp.int32):
+    """Add the records of a pass in parts (eval_block_contact) to the rock (add_contact), item by item in list order
+    in one thread (stride 1): the sums of one pass over the list in one thread. Thread i takes items i, i + stride,
+    ... (eval_block_contact)."""
+    i = wp.tid()
+    while i < counts[1]:
+        nd = rec.nodes[i]
+        e = rec.energy[i]
+        add_contact(nd[0], nd[1], nd[2], rec.force[i], rec.xi[i], e[0], e[1], f, energy_acc, loss_acc)
         i += stride

@@ -22,7 +22,7 @@ from .kernels_spring import change_lists, launch_spring_forces, spring_model, sp
 #: block; two hand-offs of ~85 µs must be paid for)
 #: block contact's scans over the whole rock: ~2 ns a spring for the changes' scan, ~7 ns a node for the displacement
 #: check (at 113k blocks, one core)
-SPLIT_SCALE = {"springs": 1, "blocks": 3, "integrate": 5, "pair_changes": 20, "displacement": 5}
+SPLIT_SCALE = {"springs": 1, "blocks": 3, "integrate": 5, "pair_changes": 20, "displacement": 5, "contact": 0.15}
 
 
 class CDEMSolver:

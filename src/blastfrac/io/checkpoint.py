@@ -34,7 +34,8 @@ SKIP = {"model", "mesh", "scenario", "topology", "builder", "config", "material"
         "mpm", "monitors", "fracture", "params", "cells", "static_pairs", "static_ends", "static_dx",
         "cand_cell", "cand_end", "host_length", "out_dir", "max_steps", "contact", "snapshots", "warnings",
         "insitu_report", "gas_report", "_pool", "_fragmentation_at", "_vibration_at", "_graph", "_clock_host",
-        "_rock_after", "ppv_out", "s_mesh", "s_hash", "s_cache", "s_hist", "s_marks", "s_prm", "_second", "_parallel",
+        "_rock_after", "ppv_out", "s_mesh", "s_hash", "s_cache", "s_hist", "s_marks", "s_prm", "s_rec", "_second",
+        "_parallel", "rec_nodes", "rec_force", "rec_xi", "rec_energy",
         "_spring_model", "_spring_states", "_spring_scalars", "geo",
         "_prm_values"}
 #: the stage objects hanging from the Simulation (walked as stages, not as its attributes)
