@@ -300,8 +300,8 @@ class BlockContact:
         self._dirty_vertices = wp.zeros(2 * self.vertex_count, dtype=wp.int32, device=d)
         self._dirty_b = wp.zeros(self.vertex_count, dtype=wp.int32, device=d)
         self._counts_b = wp.zeros(1, dtype=wp.int32, device=d)
-        # CDEMSolver._in_halves, where the solver runs stages in two threads (it sets this): the scan of the springs'
-        # changes and the displacement check, both over the whole rock, then run in two halves
+        # CDEMSolver._in_halves, where the solver runs stages in two threads (it sets this): the scan of every
+        # spring's change and the pass over the listed nodes then run in two halves
         self.in_halves = None
         # (changes, change_count): the springs whose state changed since the last pass, as the spring kernel lists
         # them (kernels_spring.list_change; CDEMSolver sets it). None: scan every spring each pass
@@ -489,6 +489,11 @@ class BlockContact:
         structs, ~100 ns, so n threads that mostly leave at once cost more than the pass)."""
         return (1, 1) if self._cpu else (n, n)
 
+    def full_scan_due(self) -> bool:
+        """True when this step's pass scans every spring's state (the first pass, or one after rescan_springs; the
+        others read the springs the spring kernel listed): the one scan of the pass that two threads split."""
+        return bool(self.fan_cache) and not (self._cache_fresh and self.changes is not None)
+
     def capturable(self) -> bool:
         """True when ``apply`` can be captured in a graph: the fan cache on (wp.HashGrid's build is not captured),
         its caches and the hash built (the first call builds them on the host)."""
@@ -502,7 +507,9 @@ class BlockContact:
     def _check_moved(self, state) -> None:
         """The displacement check: rebuild_due when a node has moved more than rebuild_skin since the build."""
         self._moved.zero_()
-        self._halves("displacement", self.model.node_count, self._largest_displacement, state)
+        # in one thread: the check streams two position arrays, and in two halves on two threads it took longer
+        # (the shipped P0's end state: 0.66 against 0.84 ms a step, benchmarks/RESULTS.md, stop 28)
+        self._largest_displacement(state)
         self._launch(rebuild_decision, 1, [self._moved, self.rebuild_skin ** 2, self._rebuild_due, self._rebuilds])
 
     def _rebuild(self, state) -> None:

@@ -20,9 +20,10 @@ from .kernels_spring import change_lists, launch_spring_forces, spring_model, sp
 #: where it costs more than ~0.5 ms (per item at 234k triangles on one core: 53 ns a spring interface, 15 ns a CST
 #: block (now with its nodes' spring forces, which a separate gather pass added at 4 ns a node), 10 ns an integrated
 #: block; two hand-offs of ~85 µs must be paid for)
-#: block contact's scans over the whole rock: ~2 ns a spring for the changes' scan, ~7 ns a node for the displacement
-#: check (at 113k blocks, one core)
-SPLIT_SCALE = {"springs": 1, "blocks": 3, "integrate": 5, "pair_changes": 20, "displacement": 5, "contact": 0.15}
+#: block contact: ~2 ns a spring for the scan of every spring's change (first pass), ~0.5 µs a node of its pass over
+#: the listed nodes (at 113k blocks, one core; from 1,500 of them). Its displacement check (every 5th step, a stream
+#: over two position arrays) is not split: in two halves it took longer (stop 28)
+SPLIT_SCALE = {"springs": 1, "blocks": 3, "integrate": 5, "pair_changes": 20, "contact": 0.15}
 
 
 class CDEMSolver:
@@ -173,15 +174,16 @@ class CDEMSolver:
         ``beside``: a stage group independent of these (the gas's forces) to run in the pool's thread meanwhile. It is
         handed over where the pool is free for it: at once when the group's first stage that could split (the CST
         blocks, or with ``blocks_done`` block contact's scan of every spring, which only its first pass and one after
-        ``rescan_springs`` make) runs in one launch, else after the last of the stages that run in two halves (CST,
-        block contact's whole-rock scans: that scan and the displacement check), so that it overlaps
-        block contact's serial rest instead of holding up a half (the shipped confined P0: the rock's rest 8.5 ms
-        with the gas handed over first, the CST's second half waiting behind it). Without a pool it runs here, last.
+        ``rescan_springs`` make) runs in one launch, else after the last of the stages that run in two halves before
+        block contact's serial rest (the CST, that scan), so that it overlaps the serial rest instead of holding up a
+        half (the shipped confined P0: the rock's rest 8.5 ms with the gas handed over first, the CST's second half
+        waiting behind it). Block contact's pass over its list, which splits too, then runs its second half in the
+        pool's thread after the gas. Without a pool it runs here, last.
         ``blocks_done``: 3b ran already (``forces_springs_blocks``)."""
         m = self.model
         fut = []
         scans = self.contact is not None and self.contact.active and self.contact.kn_area != 0.0 and \
-            bool(self.contact.fan_cache)
+            self.contact.full_scan_due()
         first = ("blocks", m.element_count) if not blocks_done else \
             ("pair_changes", m.spring_count if scans else 0)
 
