@@ -99,9 +99,10 @@ end of the demo), so the pass works from caches that change only when a spring d
   same order), each cell's points stored together with the exposure of their edge (kept by mark_pair_changes):
   a query reads memory in sequence and loads no spring state;
 - the pass reads only the state of its start and writes per node (history, quiet window), so that its order does
-  not matter: the wakes of a pass go to ``wake_stamp`` and are copied into ``elem_near``, which the woken tests read,
-  after it (before 2026-12-06 a block re-woken earlier in a pass read as not woken for the nodes after: a wake
-  could switch a block off for one step, and the result depended on the list order). With two threads and a long
+  not matter: a wake written in the pass keeps whether the block was woken before it (``contact_fan.wake_block``),
+  and the woken test reads that (before 2026-12-06 a block re-woken earlier in a pass read as not woken for the
+  nodes after: a wake could switch a block off for one step, and the result depended on the list order; the demo
+  and the shipped P0 were the same to the bit either way). With two threads and a long
   list (CDEMSolver stage "contact": from 1,500 listed nodes) the pass runs in two halves, each node's force and
   energies kept in its record (``ContactRecords``), which ``apply_contact_records`` then adds in list order: the
   sums of one pass in one thread, to the bit (tests/unit/test_threads.py). In one part the pass adds them at once;
@@ -263,8 +264,6 @@ class BlockContact:
         # nodes then search the hash too, so a node of theirs cannot enter the open block unseen (module doc).
         self.near_window = 2 * self.rebuild_interval
         self.elem_near = wp.full(model.element_count, -(1 << 30), dtype=wp.int32, device=d)
-        # the wakes of the current pass (read from the next step on: elem_near is copied from it after each pass)
-        self.wake_stamp = wp.full(model.element_count, -(1 << 30), dtype=wp.int32, device=d)
         # An open node that found no exposed edge within h_min (and no contact) skips the search for
         # rebuild_interval steps: under the speed bound above nothing can close h_min in that time. On intact
         # rock this leaves the mesh-boundary nodes one search per rebuild instead of one per step.
@@ -341,8 +340,8 @@ class BlockContact:
         hsh.cell_starts, hsh.cell_ends, hsh.sorted_xy, hsh.sorted_code = (self.cell_starts, self.cell_ends,
                                                                           self.sorted_xy, self.sorted_code)
         cache = self.s_cache = ContactCache()
-        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "wake_stamp",
-                  "query_after", "new_nodes", "new_count"):
+        for k in ("node_face", "node_flag", "fan_excl", "fan_cand", "fan_count", "elem_near", "query_after",
+                  "new_nodes", "new_count"):
             setattr(cache, k, getattr(self, k))
         marks = self.s_marks = ContactMarks()
         for k in ("pair_vertex", "seen_mode", "seen_dropped", "vertex_stamp", "iface_slots", "slot_samples",
@@ -429,14 +428,13 @@ class BlockContact:
                           self.contact_slot, self._counts, self._node_list])
             node_list, counts = self._node_list, self._counts
         # the pass over the list, in two parts on two threads where the list is long (its length is read on a CPU
-        # only, where that costs nothing), then its records added in list order and its wakes made visible
+        # only, where that costs nothing), then its records added in list order
         listed = int(counts.numpy()[1]) if self._cpu and self.in_halves is not None else 0
         self._parts = False
         self._halves("contact", listed, self._eval, state, node_list, counts, use_cache, prm, dt)
         if self._parts:
             self._launch(apply_contact_records, 1, [counts, self.s_rec, state.f, state.energy_acc, self.loss_acc, 1])
             self.passes_in_parts += 1
-        wp.copy(self.elem_near, self.wake_stamp)
 
     def rescan_springs(self) -> None:
         """The spring states (pair_mode, pair_dropped) were changed outside the spring kernel, which lists the

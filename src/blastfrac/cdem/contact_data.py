@@ -47,9 +47,8 @@ class ContactCache:
     fan_excl: wp.array(dtype=wp.int64)        # fan_exclusions mask
     fan_cand: wp.array2d(dtype=wp.int32)      # fan candidates, 4·node + exposure bits
     fan_count: wp.array(dtype=wp.int32)       # −1: not cached, walk the fan
-    elem_near: wp.array(dtype=wp.int32)       # step at which an open face last came near each element, as of the
-                                              # start of this pass (read-only in the pass: its order does not matter)
-    wake_stamp: wp.array(dtype=wp.int32)      # the same, written in the pass (BlockContact.apply copies it over)
+    elem_near: wp.array(dtype=wp.int32)       # step at which an open face last came near each element (contact_fan
+                                              # .wake_block: + WAKE_FLAG if woken then already)
     query_after: wp.array(dtype=wp.int32)     # first step an open node searches the hash again
     new_nodes: wp.array(dtype=wp.int32)       # the nodes whose flag a refresh turned from 0 (merge_candidates)
     new_count: wp.array(dtype=wp.int32)       # [1]: how many

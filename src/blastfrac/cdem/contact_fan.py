@@ -155,7 +155,7 @@ def held_search(
     candidates (fan_cache_build: the same nodes in the same order, so the same result); otherwise, or if the fan
     overflowed the cache, by walking the vertex's node list.
 
-    With ``wake`` (an open node) it also wakes (wake_stamp) the blocks of the fan whose other two nodes come
+    With ``wake`` (an open node) it also wakes (wake_block) the blocks of the fan whose other two nodes come
     within wake_dist of n's element edges at the vertex: those nodes could enter n's block through an edge that
     is not at their own vertex, which their fan search does not see (cdem/contact.py, "Cost"). The edges that
     end at the vertex itself touch n there and say nothing about that, so they wake no block."""
@@ -181,7 +181,7 @@ def held_search(
             ex2 = (code & 2) != 0
             if wake:
                 if far_nodes_near(other, xa, xn, xb, x, prm.wake_dist):
-                    cache.wake_stamp[other // 3] = step
+                    wake_block(other // 3, cache.elem_near, step, prm.near_window)
             if corner_inside(xn, other, ex1, ex2, x, touch_tol):
                 if not have_u:
                     u1 = wp.normalize(x[slot_end(n)] - xn)
@@ -201,7 +201,7 @@ def held_search(
                     # test first, the full evaluation for the few that pass
                     if wake and (ex1 or ex2):
                         if far_nodes_near(other, xa, xn, xb, x, prm.wake_dist):
-                            cache.wake_stamp[other // 3] = step
+                            wake_block(other // 3, cache.elem_near, step, prm.near_window)
                     if ex1 or ex2:
                         if corner_inside(xn, other, ex1, ex2, x, touch_tol):
                             if not have_u:
@@ -318,12 +318,37 @@ def node_faces(
     return wp.vec2d(trib, is_open)
 
 
+WAKE_FLAG = wp.constant(1 << 30)
+"""elem_near holds a wake's step t, plus WAKE_FLAG when it was written in step t onto a block already woken then."""
+
+
 @wp.func
 def node_woken(e: wp.int32, elem_near: wp.array(dtype=wp.int32), step: wp.int32, near_window: wp.int32):
-    """True if an open face came near element e in the near_window steps before this one. The wakes of this step's
-    pass go to wake_stamp and are read from the next step on (elem_near is their copy as of the start of the pass),
-    so a node's woken state does not depend on where it stands in the pass."""
-    return elem_near[e] >= step - near_window and elem_near[e] < step
+    """True if an open face came near element e in the near_window steps before this one, as of the start of this
+    step's pass: a wake written earlier in the pass (step t = this step) carries in its WAKE_FLAG whether the block
+    was woken before it (wake_block), so a node's woken state does not depend on where it stands in the pass, nor
+    on which of two threads wrote the wake first."""
+    v = elem_near[e]
+    if v >= WAKE_FLAG:
+        if v - WAKE_FLAG == step:
+            return True
+        v = v - WAKE_FLAG
+    elif v == step:
+        return False
+    return v >= step - near_window and v < step
+
+
+@wp.func
+def wake_block(e: wp.int32, elem_near: wp.array(dtype=wp.int32), step: wp.int32, near_window: wp.int32):
+    """Wake element e at this step (an open face came within wake_dist of it): elem_near[e] = step, plus WAKE_FLAG if
+    it was woken at the start of the pass (node_woken). A block already woken in this pass is left as it is. Two
+    threads waking one block write the same value, and a reader sees the same state before and after the write."""
+    v = elem_near[e]
+    if v != step and v != step + WAKE_FLAG:
+        if node_woken(e, elem_near, step, near_window):
+            elem_near[e] = step + WAKE_FLAG
+        else:
+            elem_near[e] = step
 
 
 @wp.func

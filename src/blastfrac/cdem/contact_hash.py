@@ -7,6 +7,7 @@ from __future__ import annotations
 import warp as wp
 
 from .contact_data import ContactCache, ContactHash, ContactMesh, ContactParams
+from .contact_fan import wake_block
 from .contact_geometry import (
     consider_edge,
     edge_coords,
@@ -222,7 +223,7 @@ def hash_edge(
                            vec5d(sr[0], sr[1], sr[2], sr[3], sr[4]), prm.max_depth, prm.touch_tol)
         out = vec6d(st[0], st[1], st[2], st[3], st[4], wp.min(sr[5], c[2]))
         if is_open and c[2] < prm.wake_dist:
-            cache.wake_stamp[s // 3] = step    # wake the block this open face comes near
+            wake_block(s // 3, cache.elem_near, step, prm.near_window)   # the block this open face comes near
     return out
 
 

@@ -269,7 +269,7 @@ def eval_block_contact(
 
     part: 0 the whole list, 1 its first half, 2 its second half (two threads on a CPU; each item then goes into its
     record, which apply_contact_records adds in list order once both halves have run). A node reads the state of the
-    pass's start only (positions, velocities, spring states, caches; the wakes of this pass go to wake_stamp) and
+    pass's start only (positions, velocities, spring states, caches; a wake keeps the woken state it replaces) and
     writes its own history, query window and record, so the halves are independent, and the sums are those of one
     pass in list order."""
     n = counts[1]
