@@ -6,6 +6,7 @@ importing :mod:`blastfrac` (for example to validate a scenario) stays cheap.
 
 from __future__ import annotations
 
+import ctypes
 import functools
 import os
 import re
@@ -79,7 +80,13 @@ class Launcher:
     thus always runs on what it is given; the same arguments give the same launch, bit for bit.
     ``records`` counts the recordings (a count that keeps growing means a call site alternates between arrays
     and needs a key), ``replays`` the launches replayed (benchmarks count them beside the plain ``wp.launch``
-    calls)."""
+    calls).
+
+    On a CPU a replay calls the kernel's entry point itself with an argument record built once (``_CpuReplay``):
+    Warp's own replay builds a new ctypes record of every argument at each call (~5–10 µs for the 20–30 arguments
+    of a contact or MPM launch, most of a small model's step). The record is rebuilt where an argument was set
+    again, and its struct arguments are copied in at each call (a struct's fields can change between calls), so it
+    runs on exactly what Warp's replay would; under a CPU graph capture the replay goes through Warp."""
 
     def __init__(self):
         self.records = 0
@@ -96,8 +103,7 @@ class Launcher:
             if dim != rec[2]:
                 rec[0].set_dim(dim)
                 rec[2] = dim
-            rec[0].launch()
-            self.replays += 1
+            self._replay(rec)
             return
         if rec is not None and len(rec[1]) == len(params):
             cmd, last = rec[0], rec[1]
@@ -109,18 +115,73 @@ class Launcher:
                     if a is not last[i]:
                         cmd.set_param_at_index(i, a)
                         last[i] = a
+                        if rec[3] is not None:
+                            rec[3].set(cmd, i)
                 elif a is not last[i] and a != last[i]:
                     cmd.set_param_at_index(i, a)
                     last[i] = a
+                    if rec[3] is not None:
+                        rec[3].set(cmd, i)
             else:
                 if dim != rec[2]:
                     cmd.set_dim(dim)
                     rec[2] = dim
-                cmd.launch()
-                self.replays += 1
+                self._replay(rec)
                 return
         with _RECORD_LOCK:                           # a first launch loads the kernel's module: one thread at a time
             cmd = wp.launch(kernel, dim=dim, inputs=params, device=device, record_cmd=True)
-        self._cmds[(kernel, key)] = [cmd, params, dim]
+        self._cmds[(kernel, key)] = [cmd, params, dim, _CpuReplay.of(cmd)]
         self.records += 1
         cmd.launch()
+
+    def _replay(self, rec) -> None:
+        cpu = rec[3]
+        if cpu is None or _apic_capture(rec[0].device) is not None:     # a graph capture records it
+            rec[0].launch()
+        else:
+            cpu.run(rec[0])
+        self.replays += 1
+
+
+try:                                             # Warp's internals the CPU replay needs (Warp 1.19)
+    from warp._src.codegen import Struct as _Struct
+    from warp._src.context import _get_apic_capture_for_device as _apic_capture
+except ImportError:                              # another Warp: every replay goes through Warp's own
+    _Struct = _apic_capture = None
+
+
+class _CpuReplay:
+    """A recorded CPU launch's argument record, built once (Launcher): what Warp's replay (``invoke``) builds anew
+    at every call, the same fields from the same packed arguments, and the kernel's entry point. Its struct fields
+    are copied in again at each call."""
+
+    __slots__ = ("forward", "args", "ref", "structs", "names")
+
+    @classmethod
+    def of(cls, cmd):
+        """The replay record of a recorded launch ``cmd``, or None where Warp's own replay must run it (a GPU, the
+        adjoint, a kernel with thread blocks)."""
+        if _apic_capture is None or not cmd.device.is_cpu or cmd.adjoint or cmd.block_dim > 1:
+            return None
+        args = cmd.kernel.adj.args
+        packed = cmd.params[1: 1 + len(args)]
+        fields = [(a.label, type(p)) for a, p in zip(args, packed)]
+        rec = cls()
+        rec.args = type("ArgsStruct", (ctypes.Structure,), {"_fields_": fields})()
+        for (name, _), p in zip(fields, packed):
+            setattr(rec.args, name, p)
+        rec.ref = ctypes.byref(rec.args)
+        rec.forward = cmd.hooks.forward
+        rec.structs = [(a.label, 1 + i) for i, a in enumerate(args) if isinstance(a.type, _Struct)]
+        rec.names = [a.label for a in args]
+        return rec
+
+    def set(self, cmd, index: int) -> None:
+        """Argument ``index`` was set again (Launch.set_param_at_index): copy its packed value into the record."""
+        setattr(self.args, self.names[index], cmd.params[1 + index])
+
+    def run(self, cmd) -> None:
+        params = cmd.params
+        for name, i in self.structs:
+            setattr(self.args, name, params[i])
+        self.forward(ctypes.byref(params[0]), self.ref)

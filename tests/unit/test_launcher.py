@@ -1,7 +1,8 @@
 """_warp.Launcher: recorded launches give what wp.launch gives, and follow every change of their arguments.
 
 A replay must run on the arrays, scalars, struct fields and launch size of the call it replaces: a stale
-argument would be a silently wrong step, so each kind of change is checked against a plain wp.launch.
+argument would be a silently wrong step, so each kind of change is checked against a plain wp.launch (on a CPU the
+replays run through the Launcher's own argument record, whose fields must follow each change).
 """
 
 import numpy as np
@@ -52,6 +53,8 @@ def test_replays_follow_every_argument_change():
     sc.a, sc.w = -1.5, w2                                                               # struct fields changed
     assert np.array_equal(run(x, 3.0, 4, n), _plain(x, y, 3.0, 4, sc, n))
     assert launch.records == 1 and launch.replays == 3
+    # on a CPU those replays called the kernel with the Launcher's own argument record (_CpuReplay), not Warp's
+    assert all(rec[3] is not None for rec in launch._cmds.values())
     x2 = wp.array(rng.random(n), dtype=wp.float64)                                      # another array object
     assert np.array_equal(run(x2, 3.0, 4, n), _plain(x2, y, 3.0, 4, sc, n))
     assert launch.records == 2
