@@ -134,6 +134,17 @@ def ref_weights(fx: F64):
                     F64(0.5) * (fx - F64(0.5)) * (fx - F64(0.5)))
 
 
+@wp.func
+def ref_stencil(xp: wp.vec2d, inv_dx: F64):
+    """The particle's base node (b0, b1), its offsets in that cell (fx0, fx1) and its weights along each axis."""
+    X = xp * inv_dx
+    b0 = int(wp.floor(X[0] - F64(0.5)))
+    b1 = int(wp.floor(X[1] - F64(0.5)))
+    fx0 = X[0] - F64(b0)
+    fx1 = X[1] - F64(b1)
+    return b0, b1, fx0, fx1, ref_weights(fx0), ref_weights(fx1)
+
+
 @wp.kernel
 def ref_mpm_p2g(x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), C: wp.array(dtype=wp.mat22d),
                 J: wp.array(dtype=F64), e: wp.array(dtype=F64), ng: int, inv_dx: F64, dx: F64, stress_k: F64,
@@ -142,13 +153,7 @@ def ref_mpm_p2g(x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), C: wp.
     """JWL pressure of particle p, then its APIC momentum, MLS stress impulse and mass onto its 3 × 3 nodes
     (grid: momentum x, y and mass per node; one thread on a CPU, so the adds need no atomics there)."""
     p = wp.tid()
-    X = x[p] * inv_dx
-    b0 = int(wp.floor(X[0] - F64(0.5)))
-    b1 = int(wp.floor(X[1] - F64(0.5)))
-    fx0 = X[0] - F64(b0)
-    fx1 = X[1] - F64(b1)
-    w0 = ref_weights(fx0)
-    w1 = ref_weights(fx1)
+    b0, b1, fx0, fx1, w0, w1 = ref_stencil(x[p], inv_dx)
     V = J[p]
     one = F64(1.0)
     pr = ja * (one - om / (r1 * V)) * wp.exp(-r1 * V) + jb * (one - om / (r2 * V)) * wp.exp(-r2 * V) + om * e[p] / V
@@ -207,13 +212,7 @@ def ref_mpm_g2p(gv: wp.array(dtype=wp.vec2d), pres: wp.array(dtype=F64), ng: int
                 J: wp.array(dtype=F64), e: wp.array(dtype=F64)):
     """Velocity and affine matrix from the 3 × 3 nodes, motion (clamped to the box), J and the pdV energy."""
     p = wp.tid()
-    X = x[p] * inv_dx
-    b0 = int(wp.floor(X[0] - F64(0.5)))
-    b1 = int(wp.floor(X[1] - F64(0.5)))
-    fx0 = X[0] - F64(b0)
-    fx1 = X[1] - F64(b1)
-    w0 = ref_weights(fx0)
-    w1 = ref_weights(fx1)
+    b0, b1, fx0, fx1, w0, w1 = ref_stencil(x[p], inv_dx)
     nv = wp.vec2d()
     c00 = F64(0.0)
     c01 = F64(0.0)
@@ -295,7 +294,7 @@ class Port:
 
     def __init__(self, common, device: str = "cpu"):
         c, d = common.CDEM, common.cdem_init()
-        self.c, self.device = c, device
+        self.c, self.device, self.common = c, device, common
         as64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)      # noqa: E731  (the C++ f64 build widens the same way)
         self.elem = wp.array(as64(d["elem"]), dtype=F64, device=device)
         self.X0 = wp.array(as64(d["X0"]), dtype=wp.vec2d, device=device)
@@ -335,15 +334,17 @@ class Port:
         wp.launch(ref_integrate, len(self.u0), inputs=[self.f, self.inv_mass, F64(c["alpha"]), F64(self.dt)],
                   outputs=[self.v, self.u], device=dev)
 
-    def checks(self, common) -> dict:
-        return common.cdem_checks(self.u.numpy(), self.v.numpy(), self.inv_mass.numpy(), self.broken.numpy(),
-                                  self.sigma.numpy())
+    def checks(self) -> dict:
+        return self.common.cdem_checks(self.u.numpy(), self.v.numpy(), self.inv_mass.numpy(), self.broken.numpy(),
+                                       self.sigma.numpy())
 
 
-def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> dict:
-    """Time the Warp port as the C++ program times itself (reset, ``steps`` steps, median over ``reps``) and check
-    its state after the first repetition against the built C++ f64 reference of ``ref_dir`` run on one thread.
-    Returns both RESULTs, the port's checks and the largest relative difference of the checks."""
+def _side_by_side(ref_dir: Path, cpp_args: list[str], scatter: str, make_port, steps: int | None, reps: int,
+                  device: str) -> tuple[dict, dict, float]:
+    """Run the built C++ f64 reference of ``ref_dir`` (``./bench_cpp_f64 *cpp_args``, one thread) and time the Warp
+    port ``make_port(common)`` as the C++ program times itself: reset, ``steps`` steps (the C++ run's own count by
+    default), median over ``reps``; its checks after the first repetition against the C++ run's. Returns (the C++
+    RESULT, the port's fields of the result without its size, the port's seconds a step, the port)."""
     from blastfrac._warp import init_warp
 
     init_warp()
@@ -352,52 +353,14 @@ def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> d
         import common
     finally:
         sys.path.pop(0)
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": "colour", "REPS": str(reps)}
-    r = subprocess.run(["./bench_cpp_f64", "cdem"], cwd=ref_dir, env=env, capture_output=True, text=True, check=True)
-    cpp = json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
-    p = Port(common, device)
-    p.reset()
-    p.step()                                   # load the module (kernel compile or cache read)
-    wp.synchronize_device(device)
-    walls, chk = [], None
-    for k in range(reps):
-        p.reset()
-        wp.synchronize_device(device)
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            p.step()
-        wp.synchronize_device(device)
-        walls.append(time.perf_counter() - t0)
-        if k == 0:
-            chk = p.checks(common)
-    step_s = float(np.median(walls)) / steps
-    ref = cpp["checks"]
-    rel = {k: abs(chk[k] - ref[k]) / max(abs(ref[k]), 1e-300) for k in chk}
-    return {"triangles": p.ntri, "port_step_ms": 1e3 * step_s, "port_units_steps_per_s": p.ntri / step_s,
-            "cpp_step_ms": cpp["step_ms_median"], "cpp_units_steps_per_s": cpp["units_steps_per_s"],
-            "port_over_cpp": step_s * 1e3 / cpp["step_ms_median"], "checks": chk, "cpp_checks": ref,
-            "checks_max_rel_diff": max(rel.values()), "device": device}
-
-
-def run_mpm(ref_dir: Path, n: int = 100_000, reps: int = 5, device: str = "cpu") -> dict:
-    """The MPM port timed as the C++ program times its ``mpm n`` (reset, 20 steps, median over ``reps``), its state
-    after the first repetition checked against the C++ f64 run's (one thread, SCATTER=private)."""
-    from blastfrac._warp import init_warp
-
-    init_warp()
-    sys.path.insert(0, str(ref_dir))
-    try:
-        import common
-    finally:
-        sys.path.pop(0)
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": "private", "REPS": str(reps)}
-    r = subprocess.run(["./bench_cpp_f64", "mpm", str(n)], cwd=ref_dir, env=env, capture_output=True, text=True,
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": scatter, "REPS": str(reps)}
+    r = subprocess.run(["./bench_cpp_f64", *cpp_args], cwd=ref_dir, env=env, capture_output=True, text=True,
                        check=True)
     cpp = json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
-    steps = int(cpp["nsteps"])
-    p = MPMPort(common, n, device)
+    steps = int(cpp["nsteps"]) if steps is None else steps
+    p = make_port(common)
     p.reset()
-    p.step()                                   # load the module
+    p.step()                                   # load the module (kernel compile or cache read)
     wp.synchronize_device(device)
     walls, chk = [], None
     for k in range(reps):
@@ -413,10 +376,26 @@ def run_mpm(ref_dir: Path, n: int = 100_000, reps: int = 5, device: str = "cpu")
     step_s = float(np.median(walls)) / steps
     ref = cpp["checks"]
     rel = {k: abs(chk[k] - ref[k]) / max(abs(ref[k]), 1e-300) for k in chk}
-    return {"particles": n, "port_step_ms": 1e3 * step_s, "port_units_steps_per_s": n / step_s,
-            "cpp_step_ms": cpp["step_ms_median"], "cpp_units_steps_per_s": cpp["units_steps_per_s"],
-            "port_over_cpp": step_s * 1e3 / cpp["step_ms_median"], "checks": chk, "cpp_checks": ref,
-            "checks_max_rel_diff": max(rel.values()), "device": device}
+    out = {"port_step_ms": 1e3 * step_s, "cpp_step_ms": cpp["step_ms_median"],
+           "cpp_units_steps_per_s": cpp["units_steps_per_s"], "port_over_cpp": step_s * 1e3 / cpp["step_ms_median"],
+           "checks": chk, "cpp_checks": ref, "checks_max_rel_diff": max(rel.values()), "device": device}
+    return cpp, out, step_s, p
+
+
+def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> dict:
+    """Time the CDEM port as the C++ program times itself (reset, ``steps`` steps, median over ``reps``) and check
+    its state after the first repetition against the built C++ f64 reference of ``ref_dir`` run on one thread.
+    Returns both RESULTs, the port's checks and the largest relative difference of the checks."""
+    _, out, step_s, port = _side_by_side(ref_dir, ["cdem"], "colour", lambda c: Port(c, device), steps, reps, device)
+    return {"triangles": port.ntri, "port_units_steps_per_s": port.ntri / step_s, **out}
+
+
+def run_mpm(ref_dir: Path, n: int = 100_000, reps: int = 5, device: str = "cpu") -> dict:
+    """The MPM port timed as the C++ program times its ``mpm n`` (reset, its 20 steps, median over ``reps``), its
+    state after the first repetition checked against the C++ f64 run's (one thread, SCATTER=private)."""
+    _, out, step_s, _ = _side_by_side(ref_dir, ["mpm", str(n)], "private", lambda c: MPMPort(c, n, device), None,
+                                      reps, device)
+    return {"particles": n, "port_units_steps_per_s": n / step_s, **out}
 
 
 def build(src: Path) -> Path:
