@@ -84,9 +84,9 @@ class Launcher:
 
     On a CPU a replay calls the kernel's entry point itself with an argument record built once (``_CpuReplay``):
     Warp's own replay builds a new ctypes record of every argument at each call (~5–10 µs for the 20–30 arguments
-    of a contact or MPM launch, most of a small model's step). The record is rebuilt where an argument was set
-    again, and its struct arguments are copied in at each call (a struct's fields can change between calls), so it
-    runs on exactly what Warp's replay would; under a CPU graph capture the replay goes through Warp."""
+    of a contact or MPM launch, most of a small model's step). An argument set again is copied into the record, and
+    its struct arguments are copied in at each call (a struct's fields can change between calls), so it runs on
+    exactly what Warp's replay would; under a CPU graph capture the replay goes through Warp."""
 
     def __init__(self):
         self.records = 0
@@ -113,10 +113,8 @@ class Launcher:
                         break                        # another array: record again
                 elif hasattr(a, "_cls"):             # a struct: another object is packed again
                     if a is not last[i]:
-                        cmd.set_param_at_index(i, a)
+                        cmd.set_param_at_index(i, a)     # (the CPU record copies structs in at each call)
                         last[i] = a
-                        if rec[3] is not None:
-                            rec[3].set(cmd, i)
                 elif a is not last[i] and a != last[i]:
                     cmd.set_param_at_index(i, a)
                     last[i] = a

@@ -324,6 +324,8 @@ class BlockContact:
         self.new_nodes = wp.zeros(n, dtype=wp.int32, device=d)        # flagged by this refresh for the first time
         self.new_count = wp.zeros(1, dtype=wp.int32, device=d)
         self._cpu = wp.get_device(d).is_cpu
+        # on a CPU, NumPy views of the two count arrays the pass may run over (its length, read where it may split)
+        self._host_counts = {id(a): a.numpy() for a in (self._counts, self._counts_all)} if self._cpu else {}
         self._launch = Launcher()                 # recorded launches (packing costs more than a small mesh's pass)
         self._structs()
 
@@ -429,7 +431,7 @@ class BlockContact:
             node_list, counts = self._node_list, self._counts
         # the pass over the list, in two parts on two threads where the list is long (its length is read on a CPU
         # only, where that costs nothing), then its records added in list order
-        listed = int(counts.numpy()[1]) if self._cpu and self.in_halves is not None else 0
+        listed = int(self._host_counts[id(counts)][1]) if self._cpu and self.in_halves is not None else 0
         self._parts = False
         self._halves("contact", listed, self._eval, state, node_list, counts, use_cache, prm, dt)
         if self._parts:

@@ -156,13 +156,13 @@ def contact_force(
         if history == 2:
             lost = lost + half * fs_prev * fs_prev / kc_prev      # friction history reset on a new edge
         fn = kc * p
-    pen_lost = wp.max(lost, zero)                 # (only a positive loss is booked)
+    pen_lost = wp.where(lost > zero, lost, zero)  # (only a positive loss is booked)
     slip = zero
     vt = wp.dot(v[n] - ((one - xi) * v[ia] + xi * v[ib]), t_hat)
     if fn > zero:
         cu = coulomb_update(fs, kc, vt, dt, prm.mu_f * fn)
         fs = cu[0]
-        slip = wp.max(cu[1], zero)
+        slip = wp.where(cu[1] > zero, cu[1], zero)
     elif released:
         # the same first-order correction of the last step's tangential impulse (|Fs| ≤ μ|Fn| still holds);
         # its work is taken off the slip loss booked in the steps before
