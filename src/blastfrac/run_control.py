@@ -68,13 +68,14 @@ def _restore_handlers(old: dict) -> None:
 
 def _restart_key(resolved: dict) -> str:
     """The resolved scenario without what a restart may change (end time, step limit, progress, device, threads,
-    output). The thread count changes no result (tests/unit/test_threads.py; the restart test resumes a two-thread
-    run on one)."""
+    graph, output). The thread count and the graphs change no result (tests/unit/test_threads.py,
+    test_coupled_graph.py; the restart test resumes a two-thread run on one, test_coupled_graph.py a run through the
+    launches with its coupled steps captured)."""
     import json
 
     d = {k: v for k, v in resolved.items() if k != "output"}
     d["simulation"] = {k: v for k, v in d.get("simulation", {}).items()
-                       if k not in ("end_time", "max_steps", "progress", "device", "threads")}
+                       if k not in ("end_time", "max_steps", "progress", "device", "threads", "graph")}
     return json.dumps(d, sort_keys=True, default=str)
 
 

@@ -69,8 +69,14 @@ class Simulation:
         self.cdem.ppv_out = self.ppv.ppv                               # updated by the integration kernel
         self._rock_after = None                                        # nothing after a rock step (graph key)
         # rock-only steps (no gas, or gas frozen) are replayed from a captured graph where they can be
-        # (CDEMSolver.step_captured: bit-identical; False runs every step through the launches)
-        self.use_graph = True
+        # (CDEMSolver.step_captured: bit-identical; False runs every step through the launches), and coupled steps
+        # with simulation.graph = 'on', or 'auto' on a GPU (_step_coupled_captured)
+        graph = scenario.simulation.graph
+        self.use_graph = graph != "off"
+        self.coupled_graph = graph == "on" or (graph == "auto" and self.device != "cpu")
+        self._cgraphs: dict = {}                            # captured coupled steps by the coupler's key
+        self._cgraphs_key = None                            # ... all for this key of the rest
+        self.coupled_graph_steps = 0                        # coupled steps replayed from a graph
         self.gas_report: dict = {}
         self.charge_mirror = 1.0        # whole charge over modelled charge (half and quarter models)
         if scenario.explosive is not None:
@@ -204,11 +210,14 @@ class Simulation:
         dt = self.dt
         st = self.state
         couple = gas and self.gas is not None
-        if self._second is not None:                       # the second thread where it measured faster
+        graph = couple and self.coupled_graph
+        if self._second is not None and not graph:         # the second thread where it measured faster
             self._parallel = couple and self._second.use(self.steps)
             self.cdem.pool = self._pool if self._parallel else None
         if not couple and self.use_graph and self.cdem.step_captured(st, dt, self.time, self.alpha, self._rock_after):
             pass                                           # the rock step below, replayed from a captured graph
+        elif graph and self._step_coupled_captured(dt):
+            pass                                           # the coupled step below, replayed from a captured graph
         elif couple:
             self.cdem.forces_springs_blocks(st, dt, self.time)   # springs + failure (this step's pair_mode), CST
             # the rock's rest, and the gas's forces beside it in the second thread (handed over where it is free)
@@ -231,6 +240,70 @@ class Simulation:
             self.dt = self._time_step()
         if self.cdem.contact is not None and not self.cdem.contact.active and self.steps % 16 == 0:
             self.cdem.contact.active = bool(np.any(self.state.pair_dropped.numpy()))
+
+    def _step_coupled_captured(self, dt: float) -> bool:
+        """One coupled step replayed from a captured graph (a CUDA graph on a GPU, Warp's replay of the recorded
+        operations on a CPU): the launches of the one-thread step (rock forces, gas forces beside them, the gas loads,
+        integration, the gas's advance), which read nothing back inside it. The clocks (the time at the start of the
+        step, which the springs and the burn read) and the pulses are set before the replay; the host's side of the
+        step (the coupler's schedule and history buffers, GasRockCoupler.host_step; the MPM box's schedule, renewed
+        from the particles' extent every BOX_STEPS steps, MPMSolver.advance_box) runs beside it. A graph is kept for
+        each key of the coupler (rebuild or not, history buffer: four in all) and captured again when anything else
+        it holds changes (Δt, which the host sets every 10 steps and which in the shipped examples settles within
+        their first 250–450 steps; the MPM box; block contact's settings). Returns False, having done nothing, where
+        a graph cannot stand for the step: crack gas (its rebuilds read lengths back), the first step or one after
+        Δt changed (the rock's edge loads hold the last step's Δt), block contact or the coupler not yet built
+        (their first passes build on the host), pulses on a GPU (see CDEMSolver.step_captured); and from a failed
+        capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
+        m, c, cp, gas = self.model, self.cdem.contact, self.coupler, self.gas
+        if self.crack_gas is not None or cp.cell_size == 0.0 or self.cdem.dt_prev != dt or \
+                (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
+            return False
+        rest = (id(self.state), dt, self.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
+                self.wall_load is not None)
+        if rest != self._cgraphs_key:
+            self._cgraphs, self._cgraphs_key = {}, rest
+        key = cp.graph_key()
+        t = self.time
+        self.cdem.pool = None
+        self._parallel = False
+        graph = self._cgraphs.get(key)
+        self.cdem._set_clock(t)
+        gas.set_clock(t)
+        if graph is None:
+            saved = (cp._since, cp._dt_work, cp._w_react, list(cp._hist))
+            try:
+                graph = self._capture_coupled(dt)
+            except Exception as err:                 # noqa: BLE001 (the launches can always take the step)
+                cp._since, cp._dt_work, cp._w_react, cp._hist = saved     # as before the capture's host_step
+                self.coupled_graph = False
+                self.warnings.append(f"coupled steps run through the launches: capturing one failed ({err})")
+                return False
+            self._cgraphs[key] = graph
+        else:
+            if m.pulses:
+                self.cdem.eval_pulses(t)             # the graph copies this host buffer
+            cp.host_step(dt)                         # what the captured apply did on the host
+        wp.capture_launch(graph)
+        gas.advance_box()
+        self.coupled_graph_steps += 1
+        return True
+
+    def _capture_coupled(self, dt: float):
+        """Capture the one-thread coupled step's launches (``step``'s order) as a graph, without running them."""
+        st, t, d = self.state, self.time, self.model.device
+        self.coupler.captured = self.gas.captured = self.cdem._capturing = True
+        wp.capture_begin(device=d)
+        try:
+            self.cdem.forces_springs_blocks(st, dt, t)
+            self.cdem.forces_rest(st, dt, t, beside=lambda: self._gas_forces(dt), blocks_done=True)
+            self.coupler.add_reactions(st)
+            self.cdem.integrate(st, dt, self.alpha)
+            self._gas_advance(dt)
+        finally:
+            self.coupler.captured = self.gas.captured = self.cdem._capturing = False
+            graph = wp.capture_end(device=d)
+        return graph
 
     def _gas_forces(self, dt: float) -> None:
         """Particle–edge contact (gas f_ext_p, rock reactions into f_react), wall load, crack gas, P2G, grid."""
@@ -445,7 +518,7 @@ class Simulation:
         arrays, meta = ckpt.read(path)
         if meta.get("scenario_hash") != ckpt.scenario_hash(_restart_key(resolved_dict(self.scenario))):
             raise ValueError(f"--restart {path}: the checkpoint was made from another scenario (only "
-                             "simulation.end_time, max_steps, progress, device, threads and [output] may change)")
+                             "simulation.end_time, max_steps, progress, device, threads, graph and [output] may change)")
         extra = {k: arrays.pop(k) for k in list(arrays) if k.startswith("snap")}
         ckpt.restore(self, arrays, meta["scalars"])
         run = meta["run"]
@@ -639,6 +712,8 @@ class Simulation:
             out["symmetry"] = symmetry_report(self.scenario)
         if self._second is not None:
             out["threads"] = self._second.report()
+        out["graph"] = {"mode": self.scenario.simulation.graph, "rock_steps_replayed": self.cdem.graph_steps,
+                        "coupled_steps_replayed": self.coupled_graph_steps}
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
                                 "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}

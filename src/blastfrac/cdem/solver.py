@@ -82,7 +82,7 @@ class CDEMSolver:
     def _set_clock(self, t: float) -> None:
         if self._clock_host is not None:
             self._clock_host[0] = t                 # a view of the CPU array: no launch
-        else:
+        elif not self._capturing:                   # a captured step's clock is set before each replay
             self.clock.fill_(t)
 
     def eval_pulses(self, t: float) -> None:

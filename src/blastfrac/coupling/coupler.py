@@ -6,6 +6,14 @@ the reactions are added to the rock node forces (and kept in ``f_react`` for the
 exposed edge; their centroids are hashed (``wp.HashGrid``) and each particle queries the hash, so the cost is
 linear in the number of particles. The list is rebuilt every ``rebuild_interval`` steps; between rebuilds the
 exposure of every listed edge is re-tested, and a newly cracked element joins at the next rebuild.
+
+Nothing the kernels need is read back: the list's length and largest reach stay on the device (the kernels read
+them), and the hash's cell size is fixed at the first rebuild. So a step can be captured as a graph
+(``captured = True``, set by Simulation while it captures): its launches then cover the list's capacity (the
+threads beyond its length return), its hash holds the whole capacity with the listed points as group 0 (the points
+and the order a search meets them in are those of a hash of the listed points alone), and the empty list's branch
+is taken on the device (``wp.capture_if``). Outside a capture the launches cover the list as the host reads it (a
+view on a CPU), so that a large rock with a short list costs what the list does.
 """
 
 from __future__ import annotations
@@ -20,7 +28,7 @@ from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
 from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEAT_NEW, ACC_HEATED, ACC_SIZE, ACC_STORED,
                               account_rock_work_and_clear, accumulate_gas_contact_work, add_reactions_with_work,
-                              collect_exposed_elements, eval_particle_edge_contact,
+                              collect_exposed_elements, eval_particle_edge_contact, group_listed_points,
                               heat_gas_from_contacts)
 
 
@@ -66,6 +74,7 @@ class GasRockCoupler:
         self.reach_max = wp.zeros(1, dtype=wp.float64, device=d)
         self.elems = wp.zeros(E, dtype=wp.int32, device=d)
         self.points = wp.zeros(E, dtype=wp.vec3d, device=d)
+        self.groups = wp.zeros(E, dtype=wp.int32, device=d)      # hash groups of a captured rebuild (0: listed)
         self.acc = wp.zeros(ACC_SIZE, dtype=wp.float64, device=d)
         self.diss_p = wp.zeros(max(1, mpm.n), dtype=wp.float64, device=d)   # contacts' dissipation rate per point [W/m]
         self._launch = Launcher()                 # recorded launches of the per-step kernels (_warp.Launcher)
@@ -78,8 +87,12 @@ class GasRockCoupler:
                        wp.zeros(nh, dtype=wp.float64, device=d)) for _ in range(2)]
         dim = int(min(1024, max(16, math.sqrt(E))))
         self.grid = wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64)
-        self.query_radius = 0.0
-        self.n_exposed = 0
+        # search radius = the list's largest reach (device) + this margin [m]: contact radius r_max with its preload
+        self.query_margin = (1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max
+        self.cell_size = 0.0                    # the hash's cell width [m]: the first rebuild's search radius
+        self.n_exposed = 0                      # the list's length as the host last read it (count: the device's)
+        self.captured = False                   # the step is being captured: launches over the list's capacity
+        self._count_stale = False               # captured steps have run since n_exposed was read
         self._since = self.rebuild_interval
         self._dt: float | None = None
         self.mass_floor = 1.0        # lightest a particle can become, as a fraction of its seeded mass (crack gas)
@@ -136,16 +149,32 @@ class GasRockCoupler:
         lo = wp.vec2d(max(sp.x0, sp.x0 + i0 * sp.h - grow), max(sp.y0, sp.y0 + j0 * sp.h - grow))
         hi = wp.vec2d(min(sp.x0 + (sp.nx - 1) * sp.h, sp.x0 + i1 * sp.h + grow),
                       min(sp.y0 + (sp.ny - 1) * sp.h, sp.y0 + j1 * sp.h + grow))
-        margin = wp.float64((1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max)
+        margin = wp.float64(self.query_margin)
         wp.launch(collect_exposed_elements, dim=m.element_count,
                   inputs=[self.slot_iface, state.pair_mode, state.x, self.elem_reach, lo, hi, margin],
                   outputs=[self.count, self.elems, self.points, self.reach_max], device=m.device)
-        self.n_exposed = int(self.count.numpy()[0])
-        reach = float(self.reach_max.numpy()[0])
-        self.query_radius = reach + (1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max
+        if self.captured:
+            wp.launch(group_listed_points, dim=m.element_count, inputs=[self.count, self.groups], device=m.device)
+            self.grid.build(self.points, self.cell_size, groups=self.groups)
+            self._count_stale = True
+        else:
+            self.n_exposed = int(self.count.numpy()[0])
+            self._count_stale = False
+            if self.cell_size == 0.0:
+                self.cell_size = float(self.reach_max.numpy()[0]) + self.query_margin
+            self.build_hash()
+
+    def build_hash(self) -> None:
+        """The hash of the listed points (n_exposed of them) with the fixed cell width (a rebuild outside a capture,
+        a restart)."""
         if self.n_exposed:
-            self.grid.build(self.points[: self.n_exposed], self.query_radius)
-        self._since = 0
+            self.grid.build(self.points[: self.n_exposed], self.cell_size)
+
+    def _read_count(self) -> None:
+        """n_exposed from the device after captured steps (a view on a CPU, a synchronisation on a GPU)."""
+        if self._count_stale:
+            self.n_exposed = int(self.count.numpy()[0])
+            self._count_stale = False
 
     def apply(self, state, dt: float) -> None:
         """Contact forces at the current positions: f_ext_p and f_ext_moment of the gas (assigned) and the rock
@@ -153,43 +182,79 @@ class GasRockCoupler:
         (kept inside the kernels: each step's work with the mean of the velocities before and after it, see
         ``energies``). Reads state.x, state.v and state.pair_mode only, so it may run
         beside the rock's force stages once the springs have failed for this step."""
-        mpm, m = self.mpm, self.model
-        w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
-        # over the nodes of the list that the last step's forces came from: before a rebuild replaces it
-        n_nodes = 3 * self.n_exposed
-        self._launch(account_rock_work_and_clear, dim=max(1, n_nodes),
-                     inputs=[self.elems, n_nodes, self.f_react, state.v, w_old, self.acc], device=m.device)
-        if self._since >= self.rebuild_interval:
+        m = self.model
+        nodes = self._list_nodes()                        # the last list's nodes (before a rebuild replaces it)
+        rebuild, w_old, h_in, h_out = self.host_step(dt)
+        # the second half of the last step's reactions' work over the nodes they came from, f_react cleared
+        self._launch(account_rock_work_and_clear, dim=max(1, nodes),
+                     inputs=[self.elems, self.count, self.f_react, state.v, w_old, self.acc], device=m.device)
+        if rebuild:
             self._rebuild(state)
-        self._since += 1
+        if self.captured:                                 # the list's length is known on the device only
+            wp.capture_if(self.count, on_true=lambda: self._contacts(state, dt, w_old, h_in, h_out),
+                          on_false=lambda: self._no_contacts(w_old, h_out))
+        elif self.n_exposed:
+            self._contacts(state, dt, w_old, h_in, h_out)
+        else:
+            self._no_contacts(w_old, h_out)
+
+    def host_step(self, dt: float) -> tuple:
+        """The host's side of a step (``apply`` calls it; a replayed step, Simulation, calls it alone): the rebuild
+        schedule, the step lengths of the work books, and the contact histories' buffers, read from one pair and
+        written to the other. Returns (rebuild now, w_old = ½Δt of the last step [s], histories in, out)."""
+        rebuild = self._since >= self.rebuild_interval
+        self._since = 1 if rebuild else self._since + 1
+        w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
         self._dt_work = dt
         self._w_react = 0.5 * dt                          # add_reactions books the first half of this step's
-        if self.n_exposed == 0:
-            if w_old > 0.0:
-                self._launch(accumulate_gas_contact_work, dim=mpm.n,
-                             inputs=[mpm.f_ext_p, mpm.f_ext_moment, mpm.v_pic, mpm.grad_v, mpm.active, w_old],
-                             outputs=[self.acc], device=m.device)
-            mpm.f_ext_p.zero_()
-            mpm.f_ext_moment.zero_()
-            self._hist[0][0].fill_(-1)
-            return
+        h_in, h_out = self._hist
+        self._hist = [h_out, h_in]                        # this step's histories are the next step's input
+        return rebuild, w_old, h_in, h_out
+
+    def graph_key(self) -> tuple:
+        """What a captured step holds fixed of this stage (Simulation captures again when it changes): whether it
+        rebuilds the list, the buffer its histories come from, the last step's length and the MPM box the list
+        covers."""
+        return (self._since >= self.rebuild_interval, id(self._hist[0][0]), self._dt_work, self.mpm.grid.box)
+
+    def _list_nodes(self) -> int:
+        """Threads of a launch over the listed elements' nodes: the list's capacity in a capture, else its length."""
+        if self.captured:
+            self._count_stale = True
+            return 3 * self.model.element_count
+        self._read_count()
+        return 3 * self.n_exposed
+
+    def _contacts(self, state, dt: float, w_old: float, h_in, h_out) -> None:
+        mpm, m = self.mpm, self.model
         self._launch(eval_particle_edge_contact, dim=mpm.n,
                      inputs=[self.grid.id, self.elems, self.points, self.elem_reach, self.slot_iface, state.pair_mode,
                              state.x, state.v, m.node_mass, mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p,
                              mpm.rho, mpm.active, wp.float64(self.kc), wp.float64(self.force_cap),
-                             wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max),
-                             wp.float64(self.query_radius), wp.float64(dt), wp.float64(float(self.surface_forces)),
+                             wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max), self.reach_max,
+                             wp.float64(self.query_margin), wp.float64(dt), wp.float64(float(self.surface_forces)),
                              wp.float64(float(self.pressure_preload)), wp.float64(w_old), wp.float64(0.5 * dt),
-                             wp.float64(float(self.contact_heating)), mpm.mat_kind, *self._hist[0]],
-                     outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *self._hist[1], self.diss_p],
-                     device=m.device, key=id(self._hist[0][0]))          # one record per history buffer
-        self._hist.reverse()
+                             wp.float64(float(self.contact_heating)), mpm.mat_kind, *h_in],
+                     outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *h_out, self.diss_p],
+                     device=m.device, key=id(h_in[0]))                   # one record per history buffer
+
+    def _no_contacts(self, w_old: float, h_out) -> None:
+        """No listed element: no force on the gas, an empty history (the one the step hands on), and the second half
+        of the last step's work."""
+        mpm = self.mpm
+        if w_old > 0.0:
+            self._launch(accumulate_gas_contact_work, dim=mpm.n,
+                         inputs=[mpm.f_ext_p, mpm.f_ext_moment, mpm.v_pic, mpm.grad_v, mpm.active, w_old],
+                         outputs=[self.acc], device=self.model.device)
+        mpm.f_ext_p.zero_()
+        mpm.f_ext_moment.zero_()
+        h_out[0].fill_(-1)
 
     def add_reactions(self, state) -> None:
         """state.f += this step's contact reactions (f_react), and the first half of their work at the rock's
         velocities before the step; over the nodes of the listed elements, the only ones the contacts load."""
-        self._launch(add_reactions_with_work, dim=3 * self.n_exposed,
-                     inputs=[self.elems, state.f, self.f_react, state.v, self._w_react, self.acc],
+        self._launch(add_reactions_with_work, dim=self._list_nodes(),
+                     inputs=[self.elems, self.count, state.f, self.f_react, state.v, self._w_react, self.acc],
                      device=self.model.device)
         if self.contact_heating:                          # the contacts' dissipation so far heats the gas in contact
             self._launch(heat_gas_from_contacts, dim=self.mpm.n, inputs=[self.acc, self.diss_p],

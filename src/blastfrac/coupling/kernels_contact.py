@@ -71,6 +71,15 @@ def collect_exposed_elements(
 
 
 @wp.kernel
+def group_listed_points(count: wp.array(dtype=wp.int32), groups: wp.array(dtype=wp.int32)):
+    """groups[k] = 0 for the listed points (k < count[0]), 1 for the rest of the list's capacity: the groups of a hash
+    built over the whole capacity, whose searches then meet the listed points only (a captured step, whose launch
+    sizes cannot depend on the count)."""
+    k = wp.tid()
+    groups[k] = wp.where(k < count[0], 0, 1)
+
+
+@wp.kernel
 def eval_particle_edge_contact(
     grid: wp.uint64,
     elems: wp.array(dtype=wp.int32),
@@ -94,7 +103,8 @@ def eval_particle_edge_contact(
     zeta: wp.float64,
     mu: wp.float64,
     r_max: wp.float64,
-    query_radius: wp.float64,
+    reach_max: wp.array(dtype=wp.float64),
+    query_margin: wp.float64,
     dt: wp.float64,
     surface: wp.float64,
     preload: wp.float64,
@@ -118,6 +128,10 @@ def eval_particle_edge_contact(
     which the step adds to the rock's forces: coupler.add_reactions), METHOD §3.
 
     points, elem_reach: the listed elements' centroids at the last rebuild [m] and their reach [m] (per element).
+    The search radius is reach_max[0] (the largest reach in the list, written by collect_exposed_elements) +
+    query_margin [m], read here, so that a rebuild reads nothing back. The search asks for group 0: a hash built over
+    the list's whole capacity (a captured step, GasRockCoupler) holds the listed points as group 0, and a hash of the
+    listed points alone has no groups, so it meets them all, in the same order.
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
     each (8·element + feature, ignored initial overlap δ₀ [m], effective overlap δ − δ₀ [m]); feature 0–2:
     edge k, 3–5: vertex k; −1 marks an empty slot.
@@ -148,7 +162,8 @@ def eval_particle_edge_contact(
     stored = wp.float64(0.0)
     qsum = wp.float64(0.0)
     ncon = int(0)
-    query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius)
+    query_radius = reach_max[0] + query_margin
+    query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius, 0)
     idx = int(0)
     while wp.hash_grid_query_next(query, idx):
         e = elems[idx]
@@ -275,7 +290,7 @@ def listed_node(elems: wp.array(dtype=wp.int32), i: int):
 @wp.kernel
 def account_rock_work_and_clear(
     elems: wp.array(dtype=wp.int32),
-    n_nodes: int,
+    count: wp.array(dtype=wp.int32),
     f_react: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
     w: wp.float64,
@@ -287,9 +302,10 @@ def account_rock_work_and_clear(
     the heat the last step handed to the gas (acc[HEAT_NEW], heat_gas_from_contacts): it leaves the contacts' book
     (absorbed −= it, atomically, beside the other threads' adds) into acc[HEATED], so the budget is unchanged.
 
-    Only the nodes of the listed elements (elems, the list the last step's contact kernel searched; n_nodes = 3 × its
+    Only the nodes of the listed elements (elems, the list the last step's contact kernel searched; count[0] its
     length) can carry a reaction, so the launch covers them (at least one thread, for the books) and not the whole
-    rock: on a CPU the list is in element order, so the sum is the one over all nodes, whose other terms are 0."""
+    rock: on a CPU the list is in element order, so the sum is the one over all nodes, whose other terms are 0. A
+    launch over more threads (a captured step: the list's capacity) does the same; the extra ones return."""
     i = wp.tid()
     if i == 0:
         acc[ACC_STORED] = wp.float64(0.0)
@@ -300,7 +316,7 @@ def account_rock_work_and_clear(
             wp.atomic_add(acc, ACC_ABSORBED, -q)
             acc[ACC_HEATED] = acc[ACC_HEATED] + q
             acc[ACC_HEAT_NEW] = wp.float64(0.0)
-    if i >= n_nodes:
+    if i >= 3 * count[0]:
         return
     n = listed_node(elems, i)
     f = f_react[n]
@@ -313,6 +329,7 @@ def account_rock_work_and_clear(
 @wp.kernel
 def add_reactions_with_work(
     elems: wp.array(dtype=wp.int32),
+    count: wp.array(dtype=wp.int32),
     f: wp.array(dtype=wp.vec2d),
     f_react: wp.array(dtype=wp.vec2d),
     v: wp.array(dtype=wp.vec2d),
@@ -321,8 +338,12 @@ def add_reactions_with_work(
 ):
     """f += f_react [N/m] (the gas loads on the rock nodes, after the rock's own forces) and acc[ABSORBED] −= w·f·v,
     their work at the velocities v [m/s] before the step over w = ½Δt [s] (the first half); one thread per node of
-    the listed elements (elems), the only nodes the contact kernel loads."""
-    n = listed_node(elems, wp.tid())
+    the listed elements (elems, count[0] of them), the only nodes the contact kernel loads; threads beyond them (a
+    launch over the list's capacity) return."""
+    i = wp.tid()
+    if i >= 3 * count[0]:
+        return
+    n = listed_node(elems, i)
     a = f_react[n]
     if a[0] != wp.float64(0.0) or a[1] != wp.float64(0.0):
         f[n] = f[n] + a

@@ -37,7 +37,7 @@ SKIP = {"model", "mesh", "scenario", "topology", "builder", "config", "material"
         "_rock_after", "ppv_out", "s_mesh", "s_hash", "s_cache", "s_hist", "s_marks", "s_prm", "s_rec", "_second",
         "_parallel", "rec_nodes", "rec_force", "rec_xi", "rec_energy",
         "_spring_model", "_spring_states", "_spring_scalars", "geo",
-        "_prm_values"}
+        "_prm_values", "use_graph", "coupled_graph", "_cgraphs", "_cgraphs_key"}
 #: the stage objects hanging from the Simulation (walked as stages, not as its attributes)
 ROOT_STAGES = {"state", "cdem", "coupler", "gas", "crack_gas", "wall_load", "ppv"}
 
@@ -171,5 +171,6 @@ def _rebuild_hashes(sim) -> None:
     if c is not None and getattr(c, "_built", False) and getattr(c, "_grid_kind", -1) == 0:
         c.grid.build(c.points, c.radius)                  # wp.HashGrid (fan_cache off); the cell grid is saved
     cp = getattr(sim, "coupler", None)
-    if cp is not None and cp.n_exposed and cp._since < cp.rebuild_interval:
-        cp.grid.build(cp.points[: cp.n_exposed], cp.query_radius)
+    if cp is not None and cp._since < cp.rebuild_interval:
+        cp.n_exposed, cp._count_stale = int(cp.count.numpy()[0]), False     # captured steps may have changed it
+        cp.build_hash()

@@ -24,7 +24,8 @@ def update_jwl_state(
     rho: wp.array(dtype=wp.float64),
     grad_v: wp.array(dtype=wp.mat22d),
     light_time: wp.array(dtype=wp.float64),
-    t: wp.float64,
+    clock: wp.array(dtype=wp.float64),
+    dt: wp.float64,
     p_cj: wp.float64,
     width: wp.float64,
     mode: int,
@@ -45,7 +46,8 @@ def update_jwl_state(
     cs: wp.array(dtype=wp.float64),
     stress: wp.array(dtype=wp.mat22d),
 ):
-    """Advance the burn fraction at the end-of-step time t [s] (never decreasing), then q, p [Pa], ie [J/m],
+    """Advance the burn fraction at the end-of-step time t = clock[0] + dt [s] (clock[0]: the time at the start of the
+    step, on the device so that a captured step reads it when it runs) (never decreasing), then q, p [Pa], ie [J/m],
     c [m/s] and sigma = -(p + q) I of each products particle (kind MAT_GAS; elastic points keep burn = 0 and are
     left alone)."""
     p = wp.tid()
@@ -57,6 +59,7 @@ def update_jwl_state(
     # carries no pressure): not cs[p], the time step's signal speed, which holds q's own augmentation and the
     # burn front's floor D(1 - F) and so made the linear term ~(1 + sqrt 2)x stronger than its Q2 said.
     c_mix = products_sound_speed(burn[p], wp.max(vol_prev[p] / v0, F64(0.2)), ie[p] / v0, pres[p], rho0, A, B, R1, R2, w)
+    t = clock[0] + dt
     burn[p] = burn_fraction(burn[p], t, light_time[p], V, wp.sqrt(v0), D, rho0, p_cj, width, mode)
     L = grad_v[p]
     trD = L[0, 0] + L[1, 1]

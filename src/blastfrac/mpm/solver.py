@@ -336,6 +336,9 @@ class MPMSolver:
         self.grid = Grid(spec, d)
         self._deactivated = wp.zeros(1, dtype=wp.int32, device=d)
         self._smax = wp.zeros(1, dtype=wp.float64, device=d)
+        self.clock = wp.zeros(1, dtype=wp.float64, device=d)      # time at the start of the step [s] (update_eos)
+        self.captured = False                    # a graph is capturing the step: the box's schedule is the caller's
+        self._clock_host = self.clock.numpy() if d == "cpu" else None
         if self.is_jwl:
             P = material
             self.p_cj = opts.p_cj if opts.p_cj is not None else cj_state(P).p
@@ -553,6 +556,14 @@ class MPMSolver:
             outputs=[self.x, self.vol, self.vol_prev, self.rho, self.grad_v, self._deactivated, g.extent],
             device=d,
         )
+        if not self.captured:
+            self.advance_box()
+
+    def advance_box(self) -> None:
+        """The active box's schedule, on the host, after a step's particle update: every BOX_STEPS steps it is renewed
+        from the particles' extent (read from the device: mpm/grid.py). A captured step (``captured``) leaves it to the
+        caller, after the replay."""
+        g = self.grid
         g.box_age += 1
         if g.box_age >= BOX_STEPS:
             g.renew_box()
@@ -573,16 +584,26 @@ class MPMSolver:
         if not self.is_jwl:
             return
         P, o = self.material, self.opts
+        self.set_clock(t)
         self._launch(
             update_jwl_state,
             dim=self.n,
             inputs=[self.active, self.mat_kind, self.vol0, self.vol, self.vol_prev, self.rho, self.grad_v,
-                    self.light_time, F64(t + dt), F64(self.p_cj), F64(o.burn_width), self.burn_mode,
+                    self.light_time, self.clock, F64(dt), F64(self.p_cj), F64(o.burn_width), self.burn_mode,
                     F64(P.rho0), F64(P.D),
                     F64(P.A), F64(P.B), F64(P.R1), F64(P.R2), F64(P.omega), F64(o.q1), F64(o.q2), F64(o.v_max)],
             outputs=[self.burn, self.ie, self.p, self.q, self.cs, self.stress],
             device=d,
         )
+
+    def set_clock(self, t: float) -> None:
+        """clock[0] = t [s], the time at the start of the step that update_eos reads on the device: a write into the
+        array's view on a CPU, a fill on a GPU (not while a graph is being captured: a captured step's clock is set
+        before each replay, Simulation)."""
+        if self._clock_host is not None:
+            self._clock_host[0] = t
+        elif not wp.get_device(self.device).is_capturing:
+            self.clock.fill_(t)
 
     def step(self, dt: float, t: float) -> None:
         """One MUSL step from t to t + dt [s]."""

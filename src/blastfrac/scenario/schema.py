@@ -48,6 +48,15 @@ class SimulationConfig(_Strict):
         "(benchmarks/RESULTS.md). One thread on a 1-core machine or a GPU; a sweep runs each case with 1 (its cases "
         "fill the cores).",
     )
+    graph: Literal["auto", "on", "off"] = Field(
+        "auto", description="Replay steps from a captured graph (a CUDA graph on a GPU, Warp's C++ replay of the "
+        "recorded operations on a CPU), with the same results to the bit as the launches (tests/unit/"
+        "test_rock_graph.py, test_coupled_graph.py): 'auto' replays the rock-only steps everywhere and the coupled "
+        "steps on a GPU; 'on' the coupled steps on a CPU too, in one thread (on a CPU the launches, in two threads "
+        "where that is faster, cost less: docs/scenario.md, 'Graphs'); 'off' runs every step through the launches. "
+        "A step a graph cannot stand for (the first, one after the time step changed, one with crack gas) runs "
+        "through the launches either way.",
+    )
 
 
 # --------------------------------------------------------------------------- output

@@ -1,0 +1,100 @@
+"""The captured coupled step (Simulation._step_coupled_captured, issue 14 item 1): a CPU graph replays what the
+launches do.
+
+A coupled blast (MPM products expanding from a decoupled charge into its borehole, particle–edge contact, springs that break, block contact, an MPM box
+that grows) stepped twice from the same start: once with every step through the launches (simulation.graph =
+'off'), once with the coupled steps replayed from captured graphs (simulation.graph = 'on'; on a GPU the same path
+captures CUDA graphs). Inside a graph nothing is read back: the coupler's list length, largest reach and empty-list
+branch stay on the device, the burn reads the time from a device clock. Every state array of the rock and the gas,
+the contact books and the energy terms must agree to the last bit, and the graphs must have carried the steps
+through Δt changes, list rebuilds, box renewals and fracture.
+"""
+
+import numpy as np
+import pytest
+
+from blastfrac.scenario import scenario_from_dict
+from blastfrac.simulation import Simulation
+
+ROCK = ("x", "v", "f", "sigma", "pair_F", "pair_mode", "pair_dropped", "pair_tbreak", "pair_inelastic", "pair_damp",
+        "elem_damp", "energy_acc")
+GAS = ("x", "v", "v_pic", "ie", "p", "burn", "vol", "f_ext_p")
+
+
+def _scenario(graph: str) -> dict:
+    r_b, h = 0.003, 0.00075
+    return {
+        "title": "coupled graph", "simulation": {"end_time": 6e-6, "progress": False, "threads": 1, "graph": graph},
+        "output": {"paraview": False, "figures": False},
+        "rock": {"density": 2600.0, "youngs_modulus": 50e9, "poisson_ratio": 0.2, "tensile_strength": 10e6,
+                 "cohesion": 40e6, "friction_angle": 40.0, "residual_friction_angle": 30.0,
+                 "spring_damping": 0.15},
+        "geometry": {"domain": {"type": "rectangle", "width": 0.04, "height": 0.04}, "mesh_size": 5 * h,
+                     "mesh_size_near": h, "refinement_distance": 0.012,
+                     "boreholes": [{"center": [0.0, 0.0], "radius": r_b}]},
+        "boundaries": {s: {"type": "viscous"} for s in ("left", "right", "top", "bottom")},
+        "explosive": {"name": "emulsion", "charges": [{"kind": "circle", "center": [0.0, 0.0], "radius": 0.6 * r_b}],
+                      "grid": {"cell_size": h / 3, "points_per_cell": 2, "bounds": [[-0.012, -0.012], [0.012, 0.012]]}},
+    }
+
+
+def _state(sim) -> dict:
+    out = {k: getattr(sim.state, k).numpy().copy() for k in ROCK}
+    out.update({"gas_" + k: getattr(sim.gas, k).numpy().copy() for k in GAS})
+    out["ppv"] = sim.ppv.values().copy()
+    out["coupler_acc"] = sim.coupler.acc.numpy().copy()
+    out["contact_loss"] = sim.cdem.contact.loss_acc.numpy().copy()
+    return out
+
+
+def test_captured_coupled_steps_are_bit_identical(tmp_path):
+    ref, cap = (Simulation(scenario_from_dict(_scenario(g)), out_dir=tmp_path / g) for g in ("off", "on"))
+    if ref.model.device != "cpu":
+        pytest.skip("bit-identity is a CPU property")
+    assert not ref.coupled_graph and cap.coupled_graph
+    steps, dts, boxes, listed, rebuilds = 700, set(), set(), set(), 0
+    for k in range(steps):
+        rebuilds += cap.coupler._since >= cap.coupler.rebuild_interval
+        ref.step()
+        cap.step()
+        dts.add(cap.dt)
+        boxes.add(cap.gas.grid.box)
+        listed.add(ref.coupler.n_exposed)
+        if k % 100 == 99:
+            a, b = _state(ref), _state(cap)
+            for name in a:
+                assert np.array_equal(a[name], b[name]), (k, name)
+            assert ref.time == cap.time and ref.dt == cap.dt
+    assert ref.energies() == cap.energies()
+    mode = cap.state.pair_mode.numpy()
+    print(f"\n  {cap.coupled_graph_steps} of {steps} steps replayed, {len(cap._cgraphs)} graphs held; {len(dts)} time "
+          f"steps, {len(boxes)} MPM boxes, {rebuilds} list rebuilds, {len(listed)} list lengths; {int(np.count_nonzero(mode))} springs broken, "
+          f"{cap.coupler.n_exposed} listed elements; warnings {cap.warnings}")
+    assert ref.coupled_graph_steps == 0
+    assert not cap.warnings
+    assert cap.coupled_graph_steps > steps // 2         # the graph carried most steps ...
+    # ... through Δt changes, box renewals, rebuilds of the coupler's list whose length the graph never reads
+    assert len(dts) > 2 and len(boxes) > 1 and rebuilds > 50 and len(listed) > 2
+    assert np.count_nonzero(mode) > 50                   # and fracture
+
+
+def test_a_run_resumed_with_captured_steps_is_bit_identical(tmp_path):
+    """simulation.graph may change at a restart: a run through the launches, checkpointed and stopped, then resumed
+    with its coupled steps captured (the coupler's hash rebuilt from the saved list with its saved cell width), ends
+    where the run that went through ends, to the bit."""
+    from blastfrac.run_control import CHECKPOINT_NAME
+
+    full = Simulation(scenario_from_dict(_scenario("off")), out_dir=tmp_path / "full")
+    full.run()
+    sc = _scenario("off")
+    sc["output"]["checkpoint_interval"] = 1e-6
+    part = Simulation(scenario_from_dict(sc), out_dir=tmp_path / "part", max_steps=400)
+    part.run()
+    sc["simulation"]["graph"] = "on"
+    resumed = Simulation(scenario_from_dict(sc), out_dir=tmp_path / "part")
+    resumed.run(restart=tmp_path / "part" / CHECKPOINT_NAME)
+    assert resumed.steps == full.steps and resumed.coupled_graph_steps > (full.steps - 400) // 2
+    a, b = _state(full), _state(resumed)
+    for name in a:
+        assert np.array_equal(a[name], b[name]), name
+    assert full.energies() == resumed.energies()
