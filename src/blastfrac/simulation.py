@@ -248,22 +248,24 @@ class Simulation:
         step, which the springs and the burn read) and the pulses are set before the replay; the host's side of the
         step (the coupler's schedule and history buffers, GasRockCoupler.host_step; the MPM box's schedule, renewed
         from the particles' extent every BOX_STEPS steps, MPMSolver.advance_box) runs beside it. A graph is kept for
-        each key of the coupler (rebuild or not, history buffer: four in all) and captured again when anything else
+        each key of the coupler and the crack gas (rebuild or not, history buffer: four without crack gas) and captured
+        again when anything else
         it holds changes (Δt, which the host sets every 10 steps and which in the shipped examples settles within
-        their first 250–450 steps; the MPM box; block contact's settings). Returns False, having done nothing, where
-        a graph cannot stand for the step: crack gas (its rebuilds read lengths back), the first step or one after
-        Δt changed (the rock's edge loads hold the last step's Δt), block contact or the coupler not yet built
+        their first 250–450 steps; the MPM box; block contact's settings). Crack gas likewise: its network's counts
+        stay on the device, its schedule is the host's (CrackGas.host_step). Returns False, having done nothing,
+        where a graph cannot stand for the step: the first step or one after Δt changed (the rock's edge loads hold the last step's Δt), block contact or the coupler not yet built
         (their first passes build on the host), pulses on a GPU (see CDEMSolver.step_captured); and from a failed
         capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
         m, c, cp, gas = self.model, self.cdem.contact, self.coupler, self.gas
-        if self.crack_gas is not None or cp.cell_size == 0.0 or self.cdem.dt_prev != dt or \
+        if cp.cell_size == 0.0 or self.cdem.dt_prev != dt or \
                 (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
             return False
         rest = (id(self.state), dt, self.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
                 self.wall_load is not None)
         if rest != self._cgraphs_key:
             self._cgraphs, self._cgraphs_key = {}, rest
-        key = cp.graph_key()
+        cg = self.crack_gas
+        key = (cp.graph_key(), None if cg is None else cg.graph_key())
         t = self.time
         self.cdem.pool = None
         self._parallel = False
@@ -271,11 +273,13 @@ class Simulation:
         self.cdem._set_clock(t)
         gas.set_clock(t)
         if graph is None:
-            saved = (cp._since, cp._dt_work, cp._w_react, list(cp._hist))
+            saved = (cp._since, cp._dt_work, cp._w_react, list(cp._hist), None if cg is None else (cg._since, cg._dt_prev))
             try:
                 graph = self._capture_coupled(dt)
             except Exception as err:                 # noqa: BLE001 (the launches can always take the step)
-                cp._since, cp._dt_work, cp._w_react, cp._hist = saved     # as before the capture's host_step
+                cp._since, cp._dt_work, cp._w_react, cp._hist = saved[:4]  # as before the captured host steps
+                if cg is not None:
+                    cg._since, cg._dt_prev = saved[4]
                 self.coupled_graph = False
                 self.warnings.append(f"coupled steps run through the launches: capturing one failed ({err})")
                 return False
@@ -283,7 +287,9 @@ class Simulation:
         else:
             if m.pulses:
                 self.cdem.eval_pulses(t)             # the graph copies this host buffer
-            cp.host_step(dt)                         # what the captured apply did on the host
+            cp.host_step(dt)                         # what the captured stages did on the host
+            if cg is not None:
+                cg.host_step(dt)
         wp.capture_launch(graph)
         gas.advance_box()
         self.coupled_graph_steps += 1
@@ -292,16 +298,23 @@ class Simulation:
     def _capture_coupled(self, dt: float):
         """Capture the one-thread coupled step's launches (``step``'s order) as a graph, without running them."""
         st, t, d = self.state, self.time, self.model.device
-        self.coupler.captured = self.gas.captured = self.cdem._capturing = True
+        stages = [s for s in (self.coupler, self.gas, self.crack_gas) if s is not None]
+        for s in stages:
+            s.captured = True
+        self.cdem._capturing = True
         wp.capture_begin(device=d)
         try:
             self.cdem.forces_springs_blocks(st, dt, t)
             self.cdem.forces_rest(st, dt, t, beside=lambda: self._gas_forces(dt), blocks_done=True)
             self.coupler.add_reactions(st)
+            if self.crack_gas is not None:
+                self.crack_gas.add_loads(st)
             self.cdem.integrate(st, dt, self.alpha)
             self._gas_advance(dt)
         finally:
-            self.coupler.captured = self.gas.captured = self.cdem._capturing = False
+            for s in stages:
+                s.captured = False
+            self.cdem._capturing = False
             graph = wp.capture_end(device=d)
         return graph
 

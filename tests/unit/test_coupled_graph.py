@@ -21,9 +21,10 @@ ROCK = ("x", "v", "f", "sigma", "pair_F", "pair_mode", "pair_dropped", "pair_tbr
 GAS = ("x", "v", "v_pic", "ie", "p", "burn", "vol", "f_ext_p")
 
 
-def _scenario(graph: str) -> dict:
+def _scenario(graph: str, crack_gas: bool = False) -> dict:
     r_b, h = 0.003, 0.00075
     return {
+        "crack_gas": {"enabled": crack_gas},
         "title": "coupled graph", "simulation": {"end_time": 6e-6, "progress": False, "threads": 1, "graph": graph},
         "output": {"paraview": False, "figures": False},
         "rock": {"density": 2600.0, "youngs_modulus": 50e9, "poisson_ratio": 0.2, "tensile_strength": 10e6,
@@ -44,11 +45,18 @@ def _state(sim) -> dict:
     out["ppv"] = sim.ppv.values().copy()
     out["coupler_acc"] = sim.coupler.acc.numpy().copy()
     out["contact_loss"] = sim.cdem.contact.loss_acc.numpy().copy()
+    if sim.crack_gas is not None:
+        g = sim.crack_gas.gas
+        out.update(crack_mass=g.mass.numpy().copy(), crack_energy=g.energy.numpy().copy(),
+                   crack_wet=g.wet.numpy().copy(), crack_paths=sim.crack_gas.links.count.numpy().copy())
     return out
 
 
-def test_captured_coupled_steps_are_bit_identical(tmp_path):
-    ref, cap = (Simulation(scenario_from_dict(_scenario(g)), out_dir=tmp_path / g) for g in ("off", "on"))
+@pytest.mark.parametrize("crack_gas", [False, True], ids=["particles", "crack_gas"])
+def test_captured_coupled_steps_are_bit_identical(tmp_path, crack_gas):
+    """With crack gas the network's rebuilds, flows, mouths and hand-overs to the particles run inside the graph
+    too (its counts on the device, its branches through wp.capture_if)."""
+    ref, cap = (Simulation(scenario_from_dict(_scenario(g, crack_gas)), out_dir=tmp_path / g) for g in ("off", "on"))
     if ref.model.device != "cpu":
         pytest.skip("bit-identity is a CPU property")
     assert not ref.coupled_graph and cap.coupled_graph
@@ -76,6 +84,8 @@ def test_captured_coupled_steps_are_bit_identical(tmp_path):
     # ... through Δt changes, box renewals, rebuilds of the coupler's list whose length the graph never reads
     assert len(dts) > 2 and len(boxes) > 1 and rebuilds > 50 and len(listed) > 2
     assert np.count_nonzero(mode) > 50                   # and fracture
+    if crack_gas:                                        # gas in the cracks, fed through mouths
+        assert cap.crack_gas.gas.mass.numpy().sum() > 0 and cap.crack_gas.report()["mouths"] > 0
 
 
 def test_a_run_resumed_with_captured_steps_is_bit_identical(tmp_path):

@@ -25,6 +25,12 @@ them as particles. This stage carries the gas there as a network of *cells*, one
 
 The network (wet-cell paths and mouths) is rebuilt every ``rebuild_interval`` steps; a cell that breaks in
 between is loaded from the next rebuild on. Units SI, per unit thickness.
+
+Nothing the step needs is read back: the counts of paths, mouths and released cells stay on the device, the
+launches over the paths cover the list's capacity (its kernels return beyond ``links.count``), and the branches
+(no path, no mouth, no released cell) are taken through ``wp.capture_if`` in a captured step (``captured = True``,
+set by Simulation while it captures). Outside a capture the host reads the counts (a view on a CPU) and launches
+over the paths in use.
 """
 
 from __future__ import annotations
@@ -34,8 +40,8 @@ import warp as wp
 
 from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasParticles,
                                 collect_cell_links, collect_mouths, crack_apply_flux, crack_cell_scale,
-                                crack_link_flux, crack_particle_scale, crack_refresh_particles, release_wide_cells,
-                                update_crack_cells)
+                                crack_link_flux, crack_particle_scale, crack_refresh_particles, count_paths,
+                                note_paths, release_wide_cells, update_crack_cells)
 
 
 def static_cell_links(pair_nodes: np.ndarray, node_vertex: np.ndarray, X: np.ndarray):
@@ -161,18 +167,27 @@ class CrackGas:
 
         # a cell open wider than this at both ends hands its gas to the MPM [m] (the particle spacing h/ppc)
         self.particle_size = float(mpm.spec.h / mpm.opts.ppc) if mpm is not None else 0.0
-        self._released = wp.zeros(1, dtype=wp.int32, device=d)
-        self.released_cells = 0
+        self._released = wp.zeros(1, dtype=wp.int32, device=d)           # cells released by this rebuild
+        self._released_total = wp.zeros(1, dtype=wp.int32, device=d)     # ... by the run
         self.f_nodes = wp.zeros(max(1, model.node_count), dtype=wp.vec2d, device=d)   # this step's face loads [N/m]
-        self.n_links = 0
+        self._paths = wp.zeros(1, dtype=wp.int32, device=d)              # cell–cell paths of the last rebuild
+        self._mouths = wp.zeros(1, dtype=wp.int32, device=d)             # its mouths (paths to particles)
+        self.n_links = 0                      # the two counts as the host last read them (outside a capture)
         self.n_mouths = 0
+        self._counts_stale = False            # a captured rebuild has run since they were read
+        self.captured = False                 # a graph is capturing the step: launches over the capacity
         self._since = self.rebuild_interval
         self._dt_prev = 0.0
 
+    @property
+    def released_cells(self) -> int:
+        """Cells handed to the particles so far [-] (read from the device)."""
+        return int(self._released_total.numpy()[0])
+
     # ------------------------------------------------------------------ per step
     def rebuild(self, state) -> None:
-        """Wide cells handed to the MPM, then the wet-cell paths and mouths at the present state (host reads the
-        counts)."""
+        """Wide cells handed to the MPM, then the wet-cell paths and mouths at the present state (their counts on the
+        device; the host reads them outside a capture)."""
         d = self.device
         lk = self.links
         if self.n_particles and self.particle_size > 0.0:
@@ -180,48 +195,82 @@ class CrackGas:
             wp.launch(release_wide_cells, dim=self.Q,
                       inputs=[self.cells, self.gas, self.parts, self.n_particles, state.x, state.v,
                               wp.float64(self.particle_size), wp.float64(self.mouth_radius + self.particle_size),
-                              wp.float64(self._dt_prev), self._released], device=d)
-            n_rel = int(self._released.numpy()[0])
-            self.released_cells += n_rel
-            if n_rel:
-                wp.launch(crack_refresh_particles, dim=self.n_particles, inputs=[self.parts, self.params], device=d)
+                              wp.float64(self._dt_prev), self._released, self._released_total], device=d)
+            refresh = lambda: wp.launch(crack_refresh_particles, dim=self.n_particles,  # noqa: E731
+                                        inputs=[self.parts, self.params], device=d)
+            if self.captured:
+                wp.capture_if(self._released, on_true=refresh)
+            elif int(self._released.numpy()[0]):
+                refresh()
         lk.count.zero_()
         if self.n_static:
             wp.launch(collect_cell_links, dim=self.n_static,
                       inputs=[self.static_pairs, self.static_ends, self.static_dx, self.gas.wet, lk], device=d)
-        self.n_links = int(lk.count.numpy()[0])
+        wp.launch(note_paths, dim=1, inputs=[lk.count, self._paths], device=d)
         if self.n_cand:
             wp.launch(collect_mouths, dim=self.n_cand,
                       inputs=[self.cand_cell, self.cand_end, self.cells, self.gas.wet, state.x, self.parts,
                               self.n_particles, wp.float64(self.mouth_radius), wp.float64(self.particle_floor * 1.01), lk],
                       device=d)
-        total = int(lk.count.numpy()[0])
-        self.n_mouths = total - self.n_links
-        self._since = 0
+        wp.launch(count_paths, dim=1, inputs=[lk.count, self._paths, self._mouths], device=d)
+        self._counts_stale = True
+        if not self.captured:
+            self._read_counts()
+
+    def _read_counts(self) -> None:
+        """n_links, n_mouths from the device after a rebuild (a view on a CPU, a synchronisation on a GPU)."""
+        if self._counts_stale:
+            self.n_links, self.n_mouths = int(self._paths.numpy()[0]), int(self._mouths.numpy()[0])
+            self._counts_stale = False
+
+    def host_step(self, dt: float) -> tuple[bool, float]:
+        """The host's side of a step (``apply`` calls it; a replayed step, Simulation, calls it alone): the rebuild
+        schedule and the last step's length. Returns (rebuild now, Δt of the last step [s])."""
+        rebuild = self._since >= self.rebuild_interval
+        self._since = 1 if rebuild else self._since + 1
+        dt_prev, self._dt_prev = self._dt_prev, dt
+        return rebuild, dt_prev
+
+    def graph_key(self) -> tuple:
+        """What a captured step holds fixed of this stage: whether it rebuilds the network, the last step's length."""
+        return self._since >= self.rebuild_interval, self._dt_prev
 
     def apply(self, state, dt: float) -> None:
         """Stage between the particle–edge contact and P2G: cell pressures and face forces (into f_nodes;
         ``add_loads`` adds them to state.f), then this step's flow along the network and at the mouths."""
         d = self.device
         if self._since >= self.rebuild_interval:
-            self.rebuild(state)
-        self._since += 1
+            self.rebuild(state)                   # (reads _dt_prev: before host_step moves it on)
+        _, dt_prev = self.host_step(dt)
         self.f_nodes.zero_()
         wp.launch(update_crack_cells, dim=self.Q,
                   inputs=[self.cells, self.gas, self.params, state.pair_mode, state.x, state.v,
-                          wp.float64(self._dt_prev), wp.float64(dt), self.f_nodes], device=d)
-        self._dt_prev = dt
-        n = self.n_links + self.n_mouths
-        if n == 0:
+                          wp.float64(dt_prev), wp.float64(dt), self.f_nodes], device=d)
+        if self.captured:
+            wp.capture_if(self.links.count, on_true=lambda: self._flow(dt))
             return
+        self._read_counts()
+        if self.n_links + self.n_mouths:
+            self._flow(dt)
+
+    def _flow(self, dt: float) -> None:
+        """This step's flow along the paths and through the mouths (there is at least one path)."""
+        d = self.device
+        n = self.capacity if self.captured else self.n_links + self.n_mouths
         wp.launch(crack_link_flux, dim=n, inputs=[self.links, self.gas, self.parts, self.params, wp.float64(dt)], device=d)
         wp.launch(crack_cell_scale, dim=self.Q, inputs=[self.gas, self.params], device=d)
-        if self.n_mouths:
-            wp.launch(crack_particle_scale, dim=self.n_particles,
-                      inputs=[self.parts, self.params, wp.float64(self.particle_floor)], device=d)
+        self._at_mouths(lambda: wp.launch(crack_particle_scale, dim=self.n_particles,
+                                          inputs=[self.parts, self.params, wp.float64(self.particle_floor)], device=d))
         wp.launch(crack_apply_flux, dim=n, inputs=[self.links, self.gas, self.parts], device=d)
-        if self.n_mouths:
-            wp.launch(crack_refresh_particles, dim=self.n_particles, inputs=[self.parts, self.params], device=d)
+        self._at_mouths(lambda: wp.launch(crack_refresh_particles, dim=self.n_particles,
+                                          inputs=[self.parts, self.params], device=d))
+
+    def _at_mouths(self, launch) -> None:
+        """``launch()`` where the network has mouths: on the device's count in a capture, the host's outside."""
+        if self.captured:
+            wp.capture_if(self._mouths, on_true=launch)
+        elif self.n_mouths:
+            launch()
 
     def add_loads(self, state) -> None:
         """state.f += this step's crack-face loads."""
@@ -262,7 +311,7 @@ class CrackGas:
             "pressurised_cells": int(loaded.sum()),
             "mass": float(mass.sum()), "internal_energy": float(g.energy.numpy()[: self.Q].sum()),
             "max_pressure": float(p.max()) if self.Q else 0.0,
-            "paths": self.n_links, "mouths": self.n_mouths,
+            "paths": int(self._paths.numpy()[0]), "mouths": int(self._mouths.numpy()[0]),
             "pressurised_length": float(self.host_length[loaded].sum()),
             "median_opening_pressurised": float(np.median(gap[loaded].max(axis=1))) if loaded.any() else 0.0,
         }

@@ -462,11 +462,13 @@ def crack_refresh_particles(parts: GasParticles, prm: CrackGasParams):
 @wp.kernel
 def release_wide_cells(cells: CrackCells, gas: CrackGasState, parts: GasParticles, n_particles: int,
                        x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), d_particle: wp.float64,
-                       radius: wp.float64, dt_prev: wp.float64, released: wp.array(dtype=wp.int32)):
+                       radius: wp.float64, dt_prev: wp.float64, released: wp.array(dtype=wp.int32),
+                       released_total: wp.array(dtype=wp.int32)):
     """A wet cell open wider than a material point at both ends belongs to the MPM: its gas (mass, internal
     energy and volume) joins the nearest fully burnt particle within ``radius`` of its centre, and the cell is
     marked open (wet = 2) for good: particles, not crack cells, load such a crack (by contact). The last step's
-    face forces get their pending half-step of work first, so the energy stays balanced."""
+    face forces get their pending half-step of work first, so the energy stays balanced. Counts the cells released
+    by this call (released) and by the run (released_total)."""
     q = wp.tid()
     if gas.wet[q] != 1:
         return
@@ -506,3 +508,17 @@ def release_wide_cells(cells: CrackCells, gas: CrackGasState, parts: GasParticle
     gas.pres[q] = F64(0.0)
     gas.wet[q] = 2
     wp.atomic_add(released, 0, 1)
+    wp.atomic_add(released_total, 0, 1)
+
+
+@wp.kernel
+def count_paths(count: wp.array(dtype=wp.int32), paths: wp.array(dtype=wp.int32), mouths: wp.array(dtype=wp.int32)):
+    """mouths[0] = count[0] − paths[0]: the mouths of this rebuild, once they are listed after its paths (one thread),
+    the flag of a captured step's mouth branches."""
+    mouths[0] = count[0] - paths[0]
+
+
+@wp.kernel
+def note_paths(count: wp.array(dtype=wp.int32), paths: wp.array(dtype=wp.int32)):
+    """paths[0] = count[0]: the cell–cell paths of this rebuild, before its mouths are listed (one thread)."""
+    paths[0] = count[0]

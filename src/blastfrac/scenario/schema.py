@@ -54,8 +54,8 @@ class SimulationConfig(_Strict):
         "test_rock_graph.py, test_coupled_graph.py): 'auto' replays the rock-only steps everywhere and the coupled "
         "steps on a GPU; 'on' the coupled steps on a CPU too, in one thread (on a CPU the launches, in two threads "
         "where that is faster, cost less: docs/scenario.md, 'Graphs'); 'off' runs every step through the launches. "
-        "A step a graph cannot stand for (the first, one after the time step changed, one with crack gas) runs "
-        "through the launches either way.",
+        "A step a graph cannot stand for (the first, one after the time step changed) runs through the launches "
+        "either way.",
     )
 
 
