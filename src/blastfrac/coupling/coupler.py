@@ -87,6 +87,8 @@ class GasRockCoupler:
                        wp.zeros(nh, dtype=wp.float64, device=d)) for _ in range(2)]
         dim = int(min(1024, max(16, math.sqrt(E))))
         self.grid = wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64)
+        if d != "cpu":       # a captured build of the whole capacity then allocates nothing inside a CUDA graph
+            self.grid.reserve(E, with_groups=True)
         # search radius = the list's largest reach (device) + this margin [m]: contact radius r_max with its preload
         self.query_margin = (1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max
         self.cell_size = 0.0                    # the hash's cell width [m]: the first rebuild's search radius
