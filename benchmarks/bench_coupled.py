@@ -113,8 +113,9 @@ def run_case(name: str, device: str = "cpu", steps: int = 100) -> dict:
 def fixed_cost(device: str = "cpu", steps: int = 400) -> dict:
     """The size-independent cost of a coupled step (issue 14 item 1): the demo's step on a 56-element, 20-point
     version of it (4 cm disc, 1 cm mesh, 2 mm cells, one point per cell), against the demo's own step, both on one
-    thread, over the ``steps`` steps after the first 50 (wall time); and the tiny step on two threads (what the
-    second thread's hand-offs cost)."""
+    thread, over the ``steps`` steps after the first 50 (wall time); the tiny step on two threads (what the
+    second thread's hand-offs cost) and replayed from a captured graph (``simulation.graph = 'on'``: on a GPU the
+    step's launch cost, on a CPU Warp's replay of the recorded operations against the Launcher's)."""
     import tomllib
 
     from blastfrac.scenario import scenario_from_dict
@@ -134,8 +135,11 @@ def fixed_cost(device: str = "cpu", steps: int = 400) -> dict:
     tiny2["simulation"]["threads"] = 2
     for d in (tiny, base):
         d["simulation"]["threads"] = 1                     # the launches' cost; the second thread's hand-offs apart
+        d["simulation"]["graph"] = "off"
+    tiny_g = json.loads(json.dumps(tiny))
+    tiny_g["simulation"]["graph"] = "on"
     with tempfile.TemporaryDirectory() as tmp:
-        for name, d in (("tiny", tiny), ("demo", base), ("tiny_2threads", tiny2)):
+        for name, d in (("tiny", tiny), ("demo", base), ("tiny_2threads", tiny2), ("tiny_graph", tiny_g)):
             sim = Simulation(scenario_from_dict(d), out_dir=tmp, device=device)
             for _ in range(50):
                 sim.step()
@@ -144,7 +148,9 @@ def fixed_cost(device: str = "cpu", steps: int = 400) -> dict:
                 sim.step()
             out[name + "_ms"] = (time.perf_counter() - t0) / steps * 1e3
             out[name + "_size"] = (sim.model.element_count, sim.gas.n)
+            out[name + "_replayed"] = sim.coupled_graph_steps
     out["fraction"] = out["tiny_ms"] / out["demo_ms"]
+    out["steps"] = steps
     return out
 
 

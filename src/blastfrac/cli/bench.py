@@ -81,7 +81,9 @@ def run(args) -> int:
         print(f"\nFixed cost of a step (the demo's step on {fx['tiny_size'][0]} elements and {fx['tiny_size'][1]} points, "
               f"one thread): {fx['tiny_ms']:.3f} ms, {100 * fx['fraction']:.0f} % of the demo's first steps "
               f"({fx['demo_ms']:.3f} ms); with threads = 2 {fx['tiny_2threads_ms']:.3f} ms (a step uses the second "
-              f"thread only where the run's trial measured it faster)")
+              f"thread only where the run's trial measured it faster); replayed from a captured graph "
+              f"(simulation.graph = 'on') {fx['tiny_graph_ms']:.3f} ms ({fx['tiny_graph_replayed']} of "
+              f"{50 + fx['steps']} steps replayed)")
         tc = cp.two_cores(args.two_core_steps, device) if args.two_core_steps > 0 else None
         if tc is not None:
             print(f"\nShipped confined P0 ({tc['elements']:,} blocks), {tc['steps']} steps after 20: one core "
