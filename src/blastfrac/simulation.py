@@ -33,6 +33,11 @@ from .scenario.schema import Scenario
 
 
 _BUDGET_MIN_STEPS = 50      # energy-budget samples before this step are not checked against output.budget_warning
+#: steps a coupled step runs through the launches after Δt changed, before it is captured (Δt is re-estimated every
+#: 10 steps; while the gas sets it, early in a blast, it changes at most estimates, and a graph captured for one
+#: value would serve ~10 steps: on a CPU the confined P0 reference's first 300 steps took 1.27 s captured at every
+#: change against 0.57 s through the launches)
+DT_SETTLED = 20
 class SimulationError(RuntimeError):
     """The run became unphysical (NaN, blow-up); the message says where and when.
 
@@ -77,6 +82,8 @@ class Simulation:
         self._cgraphs: dict = {}                            # captured coupled steps by the coupler's key
         self._cgraphs_key = None                            # ... all for this key of the rest
         self.coupled_graph_steps = 0                        # coupled steps replayed from a graph
+        self.coupled_graph_captures = 0                     # ... and graphs captured
+        self._dt_since = 0                                  # the step at which Δt last changed
         self.gas_report: dict = {}
         self.charge_mirror = 1.0        # whole charge over modelled charge (half and quarter models)
         if scenario.explosive is not None:
@@ -237,7 +244,10 @@ class Simulation:
         self.time += dt
         self.steps += 1
         if couple and self.steps % 10 == 0:
-            self.dt = self._time_step()
+            dt_new = self._time_step()
+            if dt_new != self.dt:
+                self._dt_since = self.steps                # a captured step waits until Δt has settled
+            self.dt = dt_new
         if self.cdem.contact is not None and not self.cdem.contact.active and self.steps % 16 == 0:
             self.cdem.contact.active = bool(np.any(self.state.pair_dropped.numpy()))
 
@@ -253,11 +263,13 @@ class Simulation:
         it holds changes (Δt, which the host sets every 10 steps and which in the shipped examples settles within
         their first 250–450 steps; the MPM box; block contact's settings). Crack gas likewise: its network's counts
         stay on the device, its schedule is the host's (CrackGas.host_step). Returns False, having done nothing,
-        where a graph cannot stand for the step: the first step or one after Δt changed (the rock's edge loads hold the last step's Δt), block contact or the coupler not yet built
+        where a graph cannot stand for the step: the first DT_SETTLED steps of the run and after each change of Δt
+        (while the gas sets Δt, early in a blast, it changes at most of its estimates, and a graph would serve a
+        few steps for the cost of its capture), block contact or the coupler not yet built
         (their first passes build on the host), pulses on a GPU (see CDEMSolver.step_captured); and from a failed
         capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
         m, c, cp, gas = self.model, self.cdem.contact, self.coupler, self.gas
-        if cp.cell_size == 0.0 or self.cdem.dt_prev != dt or \
+        if cp.cell_size == 0.0 or self.cdem.dt_prev != dt or self.steps - self._dt_since < DT_SETTLED or \
                 (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
             return False
         rest = (id(self.state), dt, self.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
@@ -284,6 +296,7 @@ class Simulation:
                 self.warnings.append(f"coupled steps run through the launches: capturing one failed ({err})")
                 return False
             self._cgraphs[key] = graph
+            self.coupled_graph_captures += 1
         else:
             if m.pulses:
                 self.cdem.eval_pulses(t)             # the graph copies this host buffer
@@ -726,7 +739,8 @@ class Simulation:
         if self._second is not None:
             out["threads"] = self._second.report()
         out["graph"] = {"mode": self.scenario.simulation.graph, "rock_steps_replayed": self.cdem.graph_steps,
-                        "coupled_steps_replayed": self.coupled_graph_steps}
+                        "coupled_steps_replayed": self.coupled_graph_steps,
+                        "coupled_graphs_captured": self.coupled_graph_captures}
         if self.gas is not None:
             out["explosive"] = {**self.gas_report, "deactivated_particles": self.gas.deactivated_count,
                                 "contact_dt": self.coupler.stable_dt(), "contacts_now": self.coupler.energies()["contacts"]}

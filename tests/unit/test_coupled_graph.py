@@ -75,13 +75,15 @@ def test_captured_coupled_steps_are_bit_identical(tmp_path, crack_gas):
             assert ref.time == cap.time and ref.dt == cap.dt
     assert ref.energies() == cap.energies()
     mode = cap.state.pair_mode.numpy()
-    print(f"\n  {cap.coupled_graph_steps} of {steps} steps replayed, {len(cap._cgraphs)} graphs held; {len(dts)} time "
+    print(f"\n  {cap.coupled_graph_steps} of {steps} steps replayed, {cap.coupled_graph_captures} graphs captured, "
+          f"{len(cap._cgraphs)} held; {len(dts)} time "
           f"steps, {len(boxes)} MPM boxes, {rebuilds} list rebuilds, {len(listed)} list lengths; {int(np.count_nonzero(mode))} springs broken, "
           f"{cap.coupler.n_exposed} listed elements; warnings {cap.warnings}")
     assert ref.coupled_graph_steps == 0
     assert not cap.warnings
     assert cap.coupled_graph_steps > steps // 2         # the graph carried most steps ...
-    # ... through Δt changes, box renewals, rebuilds of the coupler's list whose length the graph never reads
+    assert cap.coupled_graph_captures > 4               # ... captured again after Δt or the box changed
+    # through Δt changes, box renewals, rebuilds of the coupler's list whose length the graph never reads
     assert len(dts) > 2 and len(boxes) > 1 and rebuilds > 50 and len(listed) > 2
     assert np.count_nonzero(mode) > 50                   # and fracture
     if crack_gas:                                        # gas in the cracks, fed through mouths
