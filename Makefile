@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 DEMO   := examples/circular_rock/demo.toml
 
-.PHONY: demo test validate bench clean
+.PHONY: demo test validate bench gpu-check clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -40,6 +40,10 @@ validate: $(VENV)/.installed-test
 ## bench: performance suite (throughput and scaling), results printed and appended to benchmarks/
 bench: $(VENV)/.installed
 	$(BIN)/blastfrac bench
+
+## gpu-check: on a machine with a CUDA GPU, its throughput and run times and their agreement with the CPU (out/gpu_check)
+gpu-check: $(VENV)/.installed
+	$(BIN)/python benchmarks/gpu_check.py
 
 clean:
 	rm -rf out .pytest_cache
