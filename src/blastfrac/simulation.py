@@ -249,7 +249,7 @@ class Simulation:
                 self._dt_since = self.steps                # a captured step waits until Δt has settled
             self.dt = dt_new
         if self.cdem.contact is not None and not self.cdem.contact.active and self.steps % 16 == 0:
-            self.cdem.contact.active = bool(np.any(self.state.pair_dropped.numpy()))
+            self.cdem.contact.active = self.cdem.contact.any_dropped(self.state)
 
     def _step_coupled_captured(self, dt: float) -> bool:
         """One coupled step replayed from a captured graph (a CUDA graph on a GPU, Warp's replay of the recorded

@@ -110,3 +110,17 @@ def test_a_run_resumed_with_captured_steps_is_bit_identical(tmp_path):
     for name in a:
         assert np.array_equal(a[name], b[name]), name
     assert full.energies() == resumed.energies()
+
+
+def test_the_gpu_form_of_the_dropped_spring_check_reads_the_same(tmp_path):
+    """The run switches block contact on at the first dropped spring (checked every 16 steps). On a GPU the check
+    reads a device flag, not the whole array: run here on the CPU, the flag form must say what the array says."""
+    sim = Simulation(scenario_from_dict(_scenario("off")), out_dir=tmp_path)
+    c, st = sim.cdem.contact, sim.state
+    n = sim.model.spring_count
+    for dropped in ([], [0], [n - 1], [n // 3, n // 2]):
+        st.pair_dropped.assign(np.isin(np.arange(n), dropped).astype(np.int32))
+        c._cpu = True
+        on_cpu = c.any_dropped(st)
+        c._cpu = False                                   # the GPU form: flag_any_dropped and a 4-byte read
+        assert c.any_dropped(st) == on_cpu == bool(dropped)

@@ -163,7 +163,7 @@ from .contact_hash import (
     largest_displacement,
     rebuild_decision,
 )
-from .contact_kernels import apply_contact_records, eval_block_contact
+from .contact_kernels import apply_contact_records, eval_block_contact, flag_any_dropped
 
 
 class BlockContact:
@@ -324,6 +324,7 @@ class BlockContact:
         self.new_nodes = wp.zeros(n, dtype=wp.int32, device=d)        # flagged by this refresh for the first time
         self.new_count = wp.zeros(1, dtype=wp.int32, device=d)
         self._cpu = wp.get_device(d).is_cpu
+        self._dropped_flag = wp.zeros(1, dtype=wp.int32, device=d)     # any_dropped on a GPU
         # on a CPU, NumPy views of the two count arrays the pass may run over (its length, read where it may split)
         self._host_counts = {id(a): a.numpy() for a in (self._counts, self._counts_all)} if self._cpu else {}
         self._launch = Launcher()                 # recorded launches (packing costs more than a small mesh's pass)
@@ -566,6 +567,16 @@ class BlockContact:
         """Energy removed by block contact since the start [J/m]: Coulomb slip, dropped penalty energy."""
         a = self.loss_acc.numpy()
         return {"slip": float(a[LOSS_SLIP]), "penalty_dropped": float(a[LOSS_PENALTY])}
+
+    def any_dropped(self, state) -> bool:
+        """Whether a spring has dropped (the run switches block contact on at the first): on a CPU a look at the
+        array itself; on a GPU a flag set on the device and read back, 4 bytes where the array is 4 per spring."""
+        if self._cpu:
+            return bool(np.any(state.pair_dropped.numpy()))
+        self._dropped_flag.zero_()
+        wp.launch(flag_any_dropped, dim=self.model.spring_count, inputs=[state.pair_dropped, self._dropped_flag],
+                  device=self.model.device)
+        return bool(self._dropped_flag.numpy()[0])
 
     def active_count(self) -> int:
         return int(np.count_nonzero(self.contact_slot.numpy() >= 0))

@@ -305,3 +305,10 @@ def apply_contact_records(counts: wp.array(dtype=wp.int32), rec: ContactRecords,
         e = rec.energy[i]
         add_contact(nd[0], nd[1], nd[2], rec.force[i], rec.xi[i], e[0], e[1], f, energy_acc, loss_acc)
         i += stride
+
+
+@wp.kernel
+def flag_any_dropped(pair_dropped: wp.array(dtype=wp.int32), flag: wp.array(dtype=wp.int32)):
+    """flag[0] = 1 when a spring has dropped (BlockContact.any_dropped; flag zeroed before; every writer writes 1)."""
+    if pair_dropped[wp.tid()] != 0:
+        flag[0] = 1
