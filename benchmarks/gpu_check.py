@@ -33,9 +33,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import bench_cdem  # noqa: E402
-import bench_coupled  # noqa: E402
-import bench_mpm  # noqa: E402
+import bench_cdem
+import bench_coupled
+import bench_mpm
 
 TERMS = ("kinetic", "strain", "springs", "fracture", "friction", "damping", "gas_internal", "gas_kinetic",
          "contact_energy", "viscous_absorbed")

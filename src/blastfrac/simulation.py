@@ -34,10 +34,12 @@ from .scenario.schema import Scenario
 
 _BUDGET_MIN_STEPS = 50      # energy-budget samples before this step are not checked against output.budget_warning
 #: steps a coupled step runs through the launches after Δt changed, before it is captured (Δt is re-estimated every
-#: 10 steps; while the gas sets it, early in a blast, it changes at most estimates, and a graph captured for one
-#: value would serve ~10 steps: on a CPU the confined P0 reference's first 300 steps took 1.27 s captured at every
-#: change against 0.57 s through the launches)
+#: 10 steps; while the gas sets it, early in a blast, most estimates change it, and a graph captured for one value
+#: would serve ~10 steps: on a CPU the 10 mm confined P0's first 300 steps took 1.27 s captured at every change,
+#: against 0.57 s through the launches)
 DT_SETTLED = 20
+
+
 class SimulationError(RuntimeError):
     """The run became unphysical (NaN, blow-up); the message says where and when.
 
@@ -255,19 +257,18 @@ class Simulation:
         """One coupled step replayed from a captured graph (a CUDA graph on a GPU, Warp's replay of the recorded
         operations on a CPU): the launches of the one-thread step (rock forces, gas forces beside them, the gas loads,
         integration, the gas's advance), which read nothing back inside it. The clocks (the time at the start of the
-        step, which the springs and the burn read) and the pulses are set before the replay; the host's side of the
-        step (the coupler's schedule and history buffers, GasRockCoupler.host_step; the MPM box's schedule, renewed
-        from the particles' extent every BOX_STEPS steps, MPMSolver.advance_box) runs beside it. A graph is kept for
-        each key of the coupler and the crack gas (rebuild or not, history buffer: four without crack gas) and captured
-        again when anything else
-        it holds changes (Δt, which the host sets every 10 steps and which in the shipped examples settles within
-        their first 250–450 steps; the MPM box; block contact's settings). Crack gas likewise: its network's counts
-        stay on the device, its schedule is the host's (CrackGas.host_step). Returns False, having done nothing,
-        where a graph cannot stand for the step: the first DT_SETTLED steps of the run and after each change of Δt
-        (while the gas sets Δt, early in a blast, it changes at most of its estimates, and a graph would serve a
-        few steps for the cost of its capture), block contact or the coupler not yet built
-        (their first passes build on the host), pulses on a GPU (see CDEMSolver.step_captured); and from a failed
-        capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
+        step, which the springs and the burn read) and the pulses are set before the replay, and the host's side of
+        the step runs beside it: the schedules and history buffers of the coupler and the crack gas (``host_step``),
+        the MPM box's renewal every BOX_STEPS steps (MPMSolver.advance_box). A graph is kept for each of their keys
+        (rebuild or not, history buffer: four without crack gas) and all are captured again when anything else they
+        hold changes: Δt (set by the host every 10 steps; in the shipped examples it settles within their first
+        250–450 steps), the MPM box, block contact's settings.
+
+        Returns False, having done nothing, where a graph cannot stand for the step: within DT_SETTLED steps of the
+        start or of a change of Δt (while the gas sets Δt, early in a blast, most of its estimates change it, and a
+        graph would serve a few steps for the cost of its capture), before the first passes of block contact and
+        the coupler (they build their caches on the host), with pulses on a GPU (CDEMSolver.step_captured), and
+        from a failed capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
         m, c, cp, gas = self.model, self.cdem.contact, self.coupler, self.gas
         if cp.cell_size == 0.0 or self.cdem.dt_prev != dt or self.steps - self._dt_since < DT_SETTLED or \
                 (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):

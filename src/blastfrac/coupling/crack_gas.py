@@ -196,7 +196,7 @@ class CrackGas:
                       inputs=[self.cells, self.gas, self.parts, self.n_particles, state.x, state.v,
                               wp.float64(self.particle_size), wp.float64(self.mouth_radius + self.particle_size),
                               wp.float64(self._dt_prev), self._released, self._released_total], device=d)
-            refresh = lambda: wp.launch(crack_refresh_particles, dim=self.n_particles,  # noqa: E731
+            refresh = lambda: wp.launch(crack_refresh_particles, dim=self.n_particles,
                                         inputs=[self.parts, self.params], device=d)
             if self.captured:
                 wp.capture_if(self._released, on_true=refresh)
