@@ -245,6 +245,8 @@ class Simulation:
             self.cdem.integrate(st, dt, self.alpha)        # central difference on rock nodes, PPV: max |v| per node
         self.time += dt
         self.steps += 1
+        if couple and self.gas.grid.box_age == 0:
+            self.coupler.note_reach()                      # with the box's renewal: the hash's next cell width
         if couple and self.steps % 10 == 0:
             dt_new = self._time_step()
             if dt_new != self.dt:
