@@ -251,7 +251,7 @@ class GasRockCoupler:
     def _contacts(self, state, dt: float, w_old: float, h_in, h_out) -> None:
         mpm, m = self.mpm, self.model
         self._launch(eval_particle_edge_contact, dim=mpm.n,
-                     inputs=[self.grid.id, self.elems, self.points, self.elem_reach, self.slot_iface, state.pair_mode,
+                     inputs=[self.grid.id, self.elems, self.points, self.slot_iface, state.pair_mode,
                              state.x, state.v, m.node_mass, mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p,
                              mpm.rho, mpm.active, wp.float64(self.kc), wp.float64(self.force_cap),
                              wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max), self.reach_max,

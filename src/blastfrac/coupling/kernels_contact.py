@@ -49,7 +49,8 @@ def collect_exposed_elements(
     points: wp.array(dtype=wp.vec3d),
     reach_max: wp.array(dtype=wp.float64),
 ):
-    """Compact list of elements with an exposed edge, their centroids (z = 0) and the largest reach [m].
+    """Compact list of elements with an exposed edge, their centroids with their reach as z [m] (a hash one cell deep
+    files every z in its one layer, and a search reads the reach with the centroid) and the largest reach [m].
 
     Only elements that a particle inside the box box_lo..box_hi [m] (the MPM grid, which particles never
     leave) can reach are listed: centroid within reach + margin [m] of the box. Large far-field boundary
@@ -66,7 +67,7 @@ def collect_exposed_elements(
         return
     k = wp.atomic_add(count, 0, 1)
     elems[k] = e
-    points[k] = wp.vec3d(c[0], c[1], wp.float64(0.0))
+    points[k] = wp.vec3d(c[0], c[1], elem_reach[e])      # z: the reach (the hash is one cell deep: z hashes to 0)
     wp.atomic_max(reach_max, 0, elem_reach[e])
 
 
@@ -84,7 +85,6 @@ def eval_particle_edge_contact(
     grid: wp.uint64,
     elems: wp.array(dtype=wp.int32),
     points: wp.array(dtype=wp.vec3d),
-    elem_reach: wp.array(dtype=wp.float64),
     slot_iface: wp.array(dtype=wp.int32),
     pair_mode: wp.array(dtype=wp.int32),
     x_rock: wp.array(dtype=wp.vec2d),
@@ -127,7 +127,7 @@ def eval_particle_edge_contact(
     """Contact force on each particle (assigned to f_p) and its reactions on the rock nodes (added to f_react,
     which the step adds to the rock's forces: coupler.add_reactions), METHOD §3.
 
-    points, elem_reach: the listed elements' centroids at the last rebuild [m] and their reach [m] (per element).
+    points: the listed elements' centroids at the last rebuild, their reach as z [m] (collect_exposed_elements).
     The search radius is reach_max[0] (the largest reach in the list, written by collect_exposed_elements) +
     query_margin [m], read here, so that a rebuild reads nothing back. The search asks for group 0: a hash built over
     the list's whole capacity (a captured step, GasRockCoupler) holds the listed points as group 0, and a hash of the
@@ -166,15 +166,16 @@ def eval_particle_edge_contact(
     query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius, 0)
     idx = int(0)
     while wp.hash_grid_query_next(query, idx):
-        e = elems[idx]
         # the hash returns whole cells: skip elements whose reach (from the centroid listed at the last rebuild,
-        # with the same allowance for motion as the search radius) cannot meet the particle's contact disk
+        # with the same allowance for motion as the search radius; the point's z) cannot meet the particle's
+        # contact disk, before loading anything else of them
         c = points[idx]
         dx = xp[0] - c[0]
         dy = xp[1] - c[1]
-        lim = elem_reach[e] + rc
+        lim = c[2] + rc
         if dx * dx + dy * dy > lim * lim:
             continue
+        e = elems[idx]
         best = wp.float64(-1.0)
         bn = wp.vec2d(zero, zero)
         ia = int(-1)
