@@ -8,11 +8,12 @@ linear in the number of particles. The list is rebuilt every ``rebuild_interval`
 exposure of every listed edge is re-tested, and a newly cracked element joins at the next rebuild.
 
 Nothing the kernels need is read back: the list's length and largest reach stay on the device (the kernels read
-them). The hash's cell width follows the search radius in steps of CELL_GROWTH (``note_reach``: from the largest reach
-the host last read, at the MPM box's renewal, where it reads the box anyway), so it changes a few times a run. So
-a step can be captured as a graph
+them). The listed elements are hashed in two size classes, each in its own hash, so that the few large blocks of a
+coarse far mesh do not widen every particle's search; the split and the cell widths follow the list's reach in steps
+of CELL_GROWTH (``note_reach``: from the reach the host last read, at the MPM box's renewal, where it reads the box
+anyway), so they change a few times a run. So a step can be captured as a graph
 (``captured = True``, set by Simulation while it captures): its launches then cover the list's capacity (the
-threads beyond its length return), its hash holds the whole capacity with the listed points as group 0 (the points
+threads beyond its length return), its hashes hold the whole capacity with the listed points as group 0 (the points
 and the order a search meets them in are those of a hash of the listed points alone), and the empty list's branch
 is taken on the device (``wp.capture_if``). Outside a capture the launches cover the list as the host reads it (a
 view on a CPU), so that a large rock with a short list costs what the list does.
@@ -28,14 +29,16 @@ import warp as wp
 from .._warp import Launcher
 from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
-from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEAT_NEW, ACC_HEATED, ACC_SIZE, ACC_STORED,
-                              account_rock_work_and_clear, accumulate_gas_contact_work, add_reactions_with_work,
-                              collect_exposed_elements, eval_particle_edge_contact, group_listed_points,
+from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEAT_NEW, ACC_HEATED, ACC_SIZE, ACC_STORED, LARGE,
+                              REACH_COUNT, REACH_MAX, REACH_SUM, SMALL, account_rock_work_and_clear,
+                              accumulate_gas_contact_work, add_reactions_with_work, collect_exposed_elements, eval_particle_edge_contact, group_listed_points,
                               heat_gas_from_contacts)
 
 
 #: ratio of one hash cell width to the next (GasRockCoupler.note_reach) [-]
 CELL_GROWTH = 1.25
+#: the small elements' hash holds those of reach up to this multiple of the list's mean (GasRockCoupler.note_reach) [-]
+CELL_REACH = 1.5
 
 
 def default_contact_stiffness(p_cj: float, factor: float = 20.0) -> float:
@@ -77,9 +80,12 @@ class GasRockCoupler:
         E = model.element_count
         self.slot_iface = wp.array(model.topology.slot_iface.astype(np.int32), dtype=wp.int32, device=d)
         self.count = wp.zeros(1, dtype=wp.int32, device=d)
-        self.reach_max = wp.zeros(1, dtype=wp.float64, device=d)
+        self.reach = wp.zeros(3, dtype=wp.float64, device=d)     # the list's largest and summed reach, its length
         self.elems = wp.zeros(E, dtype=wp.int32, device=d)
-        self.points = wp.zeros(E, dtype=wp.vec3d, device=d)
+        # the list by size class (kernels_contact SMALL, LARGE), each with its own hash: elements, points, counts
+        self.cls_elems = wp.zeros(2 * E, dtype=wp.int32, device=d)      # class c from c·E on
+        self.cls_points = wp.zeros(2 * E, dtype=wp.vec3d, device=d)
+        self.cls_count = wp.zeros(2, dtype=wp.int32, device=d)
         self.groups = wp.zeros(E, dtype=wp.int32, device=d)      # hash groups of a captured rebuild (0: listed)
         self.acc = wp.zeros(ACC_SIZE, dtype=wp.float64, device=d)
         self.diss_p = wp.zeros(max(1, mpm.n), dtype=wp.float64, device=d)   # contacts' dissipation rate per point [W/m]
@@ -92,13 +98,17 @@ class GasRockCoupler:
         self._hist = [(wp.full(nh, -1, dtype=wp.int32, device=d), wp.zeros(nh, dtype=wp.float64, device=d),
                        wp.zeros(nh, dtype=wp.float64, device=d)) for _ in range(2)]
         dim = int(min(1024, max(16, math.sqrt(E))))
-        self.grid = wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64)
+        self.grids = [wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64) for _ in range(2)]   # SMALL, LARGE
         if d != "cpu":       # a captured build of the whole capacity then allocates nothing inside a CUDA graph
-            self.grid.reserve(E, with_groups=True)
+            for g in self.grids:
+                g.reserve(E, with_groups=True)
         # search radius = the list's largest reach (device) + this margin [m]: contact radius r_max with its preload
         self.query_margin = (1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max
-        self.cell_size = 0.0                    # the hash's cell width [m] (note_reach; 0 until the first rebuild)
+        self.cell_size = 0.0                    # the small hash's cell width [m] (note_reach; 0 until the first rebuild)
+        self.cell_large = 0.0                   # the large hash's [m]
+        self.split = math.inf                   # an element is small where its reach + query_margin is within it [m]
         self.n_exposed = 0                      # the list's length as the host last read it (count: the device's)
+        self.n_class = [0, 0]                   # ... and its classes'
         self.captured = False                   # the step is being captured: launches over the list's capacity
         self._count_stale = False               # captured steps have run since n_exposed was read
         self._since = self.rebuild_interval
@@ -146,7 +156,8 @@ class GasRockCoupler:
     def _rebuild(self, state) -> None:
         m = self.model
         self.count.zero_()
-        self.reach_max.zero_()
+        self.cls_count.zero_()
+        self.reach.zero_()
         # the elements a particle can reach before the next rebuild: within the MPM grid's active node box (which
         # holds every particle until its next renewal, mpm/grid.py), widened by a cell per step to this list's next
         # rebuild plus one renewal period (a particle moves less than a cell per step); not the whole grid, whose
@@ -159,43 +170,70 @@ class GasRockCoupler:
                       min(sp.y0 + (sp.ny - 1) * sp.h, sp.y0 + j1 * sp.h + grow))
         margin = wp.float64(self.query_margin)
         wp.launch(collect_exposed_elements, dim=m.element_count,
-                  inputs=[self.slot_iface, state.pair_mode, state.x, self.elem_reach, lo, hi, margin],
-                  outputs=[self.count, self.elems, self.points, self.reach_max], device=m.device)
+                  inputs=[self.slot_iface, state.pair_mode, state.x, self.elem_reach, lo, hi, margin,
+                          wp.float64(self.split)],
+                  outputs=[self.count, self.elems, self.cls_count, self.cls_elems, self.cls_points, self.reach],
+                  device=m.device)
         if self.captured:
-            wp.launch(group_listed_points, dim=m.element_count, inputs=[self.count, self.groups], device=m.device)
-            self.grid.build(self.points, self.cell_size, groups=self.groups)
+            for c, cell in ((SMALL, self.cell_size), (LARGE, self.cell_large)):
+                wp.launch(group_listed_points, dim=m.element_count, inputs=[self.cls_count, c, self.groups],
+                          device=m.device)
+                self.grids[c].build(self.cls_points[c * m.element_count: (c + 1) * m.element_count], cell,
+                                    groups=self.groups)
             self._count_stale = True
         else:
-            self.n_exposed = int(self.count.numpy()[0])
-            self._count_stale = False
+            self._count_stale = True
+            self._read_count()
             if self.cell_size == 0.0:                    # the first rebuild (never captured)
                 self.note_reach()
             self.build_hash()
 
     def note_reach(self) -> None:
-        """Read the list's largest reach back and set the hash's cell width for the next rebuilds: the search radius
-        it gives (reach + query_margin) rounded down to query_margin·CELL_GROWTH^k. Called at the first rebuild and by
-        Simulation after each renewal of the MPM box (every 5 steps, where the step reads the box back anyway), in a
-        captured run and through the launches alike, so both build the same hash. A cell about one search radius
-        wide is what a search costs least with; the steps keep the widths, and so the graphs that hold them, to a
-        few a run. Measured at the demo's end (search radius 3.64 mm, grown from 1.3 mm as cracks exposed larger
-        blocks; the contact pass, one thread): cell = the radius (before 2026-12-06) 0.89 ms a step; fixed at the
-        first rebuild's 1.29 mm 1.26 ms; rounded down in steps of 1.25 (3.64 mm) 0.91, of 1.1 (3.39 mm) 0.87;
-        rounded up in steps of 1.25 (4.55 mm) 0.96."""
-        radius = float(self.reach_max.numpy()[0]) + self.query_margin
+        """Read the list's reach statistics back and set the cell widths of the two hashes for the next rebuilds:
+        the small elements' CELL_REACH times the list's mean reach + query_margin, the large ones' its largest reach
+        + query_margin, each rounded down to query_margin·CELL_GROWTH^k; the first is also the split (``split``: an
+        element is small where its reach + query_margin is within it). Where the second is less than CELL_GROWTH³ (≈ 2)
+        times the first, every element is small (split = ∞) and searched within the largest reach, in a hash of the
+        second width. An element whose reach + query_margin fits
+        in the small hash's cell is small: a particle finds it with a search one cell wide; the larger ones (a coarse
+        far mesh's blocks that cracks expose), with a search of the largest reach in their own sparse hash, so that
+        they no longer widen every particle's search. Called at the first rebuild and by Simulation after each
+        renewal of the MPM box (every 5 steps, where the step reads the box back anyway), in a captured run and
+        through the launches alike, so both build the same hashes; the steps keep the widths, and so the graphs
+        that hold them, to a few a run.
+
+        Measured at the end states of the benchmark's demo (6 mm far mesh, 896 listed elements of reach 0.65–3.33 mm,
+        median 1.27) and confined P0 (10 mm far mesh, 919 listed), the coupler's pass on one thread
+        (benchmarks/RESULTS.md, stop 29): one hash with a cell of the largest search radius (3.64 / 3.02 mm) 0.89 /
+        0.32 ms a step; with the reach in the points' z 0.76–0.79 / 0.32; two classes (small cell 1.86 mm: 652 /
+        660 small, 244 / 259 large) 0.63 / 0.35, hence one class where the largest radius is under about twice the
+        small one (P0: 2.91 against 1.86 mm).
+        """
+        st = self.reach.numpy()
+        mean = st[REACH_SUM] / st[REACH_COUNT] if st[REACH_COUNT] > 0 else 0.0
+        self.cell_large = self._cell(st[REACH_MAX] + self.query_margin)
+        self.cell_size = self.split = self._cell(CELL_REACH * mean + self.query_margin)
+        if self.cell_large < CELL_GROWTH ** 3 * self.cell_size * (1.0 - 1e-9):
+            self.cell_size, self.split = self.cell_large, math.inf    # a second search would save less than it costs
+
+    def _cell(self, radius: float) -> float:
+        """radius [m] rounded down to query_margin·CELL_GROWTH^k (k ≥ 0)."""
         k = max(0, math.floor(math.log(radius / self.query_margin) / math.log(CELL_GROWTH)))
-        self.cell_size = self.query_margin * CELL_GROWTH ** k
+        return self.query_margin * CELL_GROWTH ** k
 
     def build_hash(self) -> None:
-        """The hash of the listed points (n_exposed of them) with the fixed cell width (a rebuild outside a capture,
-        a restart)."""
-        if self.n_exposed:
-            self.grid.build(self.points[: self.n_exposed], self.cell_size)
+        """The hashes of the listed points of each class (n_class of them) with their cell widths (a rebuild outside
+        a capture, a restart)."""
+        for c, cell in ((SMALL, self.cell_size), (LARGE, self.cell_large)):
+            if self.n_class[c]:
+                E = self.model.element_count
+                self.grids[c].build(self.cls_points[c * E: c * E + self.n_class[c]], cell)
 
     def _read_count(self) -> None:
-        """n_exposed from the device after captured steps (a view on a CPU, a synchronisation on a GPU)."""
+        """n_exposed and n_class from the device after a rebuild (a view on a CPU, a synchronisation on a GPU)."""
         if self._count_stale:
             self.n_exposed = int(self.count.numpy()[0])
+            self.n_class = [int(v) for v in self.cls_count.numpy()]
             self._count_stale = False
 
     def apply(self, state, dt: float) -> None:
@@ -236,9 +274,9 @@ class GasRockCoupler:
     def graph_key(self) -> tuple:
         """What a captured step holds fixed of this stage (Simulation captures again when it changes): whether it
         rebuilds the list, the buffer its histories come from, the last step's length, the MPM box the list covers
-        and the hash's cell width."""
+        and the hashes' cell widths and split."""
         return (self._since >= self.rebuild_interval, id(self._hist[0][0]), self._dt_work, self.mpm.grid.box,
-                self.cell_size)
+                self.cell_size, self.cell_large, self.split)
 
     def _list_nodes(self) -> int:
         """Threads of a launch over the listed elements' nodes: the list's capacity in a capture, else its length."""
@@ -251,11 +289,12 @@ class GasRockCoupler:
     def _contacts(self, state, dt: float, w_old: float, h_in, h_out) -> None:
         mpm, m = self.mpm, self.model
         self._launch(eval_particle_edge_contact, dim=mpm.n,
-                     inputs=[self.grid.id, self.elems, self.points, self.slot_iface, state.pair_mode,
+                     inputs=[self.grids[SMALL].id, self.grids[LARGE].id, self.cls_count, self.cls_elems,
+                             self.cls_points, self.slot_iface, state.pair_mode,
                              state.x, state.v, m.node_mass, mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p,
                              mpm.rho, mpm.active, wp.float64(self.kc), wp.float64(self.force_cap),
-                             wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max), self.reach_max,
-                             wp.float64(self.query_margin), wp.float64(dt), wp.float64(float(self.surface_forces)),
+                             wp.float64(self.zeta), wp.float64(self.mu), wp.float64(self.r_max), self.reach,
+                             wp.float64(self.query_margin), wp.float64(self.split), wp.float64(dt), wp.float64(float(self.surface_forces)),
                              wp.float64(float(self.pressure_preload)), wp.float64(w_old), wp.float64(0.5 * dt),
                              wp.float64(float(self.contact_heating)), mpm.mat_kind, *h_in],
                      outputs=[mpm.f_ext_p, mpm.f_ext_moment, self.f_react, self.acc, *h_out, self.diss_p],

@@ -35,6 +35,16 @@ def contact_power(f: wp.vec2d, M: wp.mat22d, v: wp.vec2d, L: wp.mat22d):
     return wp.dot(f, v) + M[0, 0] * L[0, 0] + M[0, 1] * L[0, 1] + M[1, 0] * L[1, 0] + M[1, 1] * L[1, 1]
 
 
+#: the coupler's reach statistics (GasRockCoupler.reach): largest reach, sum of the reaches, elements listed [m, m, -]
+REACH_MAX = 0
+REACH_SUM = 1
+REACH_COUNT = 2
+#: the listed elements' size classes, each with its own hash: small (reach + margin within the small hash's cell,
+#: found by a search one cell wide) and large (found by a search of the largest reach)
+SMALL = 0
+LARGE = 1
+
+
 @wp.kernel
 def collect_exposed_elements(
     slot_iface: wp.array(dtype=wp.int32),
@@ -44,13 +54,18 @@ def collect_exposed_elements(
     box_lo: wp.vec2d,
     box_hi: wp.vec2d,
     margin: wp.float64,
+    split: wp.float64,
     count: wp.array(dtype=wp.int32),
     elems: wp.array(dtype=wp.int32),
-    points: wp.array(dtype=wp.vec3d),
-    reach_max: wp.array(dtype=wp.float64),
+    cls_count: wp.array(dtype=wp.int32),
+    cls_elems: wp.array(dtype=wp.int32),
+    cls_points: wp.array(dtype=wp.vec3d),
+    reach: wp.array(dtype=wp.float64),
 ):
-    """Compact list of elements with an exposed edge, their centroids with their reach as z [m] (a hash one cell deep
-    files every z in its one layer, and a search reads the reach with the centroid) and the largest reach [m].
+    """Compact list of the elements with an exposed edge (elems, count[0] of them), and the same elements by size
+    class (cls_elems[c], cls_count[c]; SMALL: reach + margin ≤ split [m], else LARGE) with their centroids and reach as
+    z [m] (cls_points[c]: a hash one cell deep files every z in its one layer, and a search reads the reach with the
+    centroid), and the list's reach statistics (reach[REACH_MAX, REACH_SUM, REACH_COUNT]).
 
     Only elements that a particle inside the box box_lo..box_hi [m] (the MPM grid, which particles never
     leave) can reach are listed: centroid within reach + margin [m] of the box. Large far-field boundary
@@ -62,29 +77,37 @@ def collect_exposed_elements(
             or slot_exposed(s + 2, slot_iface, pair_mode)):
         return
     c = (x[s] + x[s + 1] + x[s + 2]) / wp.float64(3.0)
-    r = elem_reach[e] + margin
+    re = elem_reach[e]
+    r = re + margin
     if c[0] < box_lo[0] - r or c[0] > box_hi[0] + r or c[1] < box_lo[1] - r or c[1] > box_hi[1] + r:
         return
     k = wp.atomic_add(count, 0, 1)
     elems[k] = e
-    points[k] = wp.vec3d(c[0], c[1], elem_reach[e])      # z: the reach (the hash is one cell deep: z hashes to 0)
-    wp.atomic_max(reach_max, 0, elem_reach[e])
+    cls = wp.where(r <= split, SMALL, LARGE)
+    j = cls * elem_reach.shape[0] + wp.atomic_add(cls_count, cls, 1)      # class c from c·(elements) on
+    cls_elems[j] = e
+    cls_points[j] = wp.vec3d(c[0], c[1], re)
+    wp.atomic_max(reach, REACH_MAX, re)
+    wp.atomic_add(reach, REACH_SUM, re)
+    wp.atomic_add(reach, REACH_COUNT, wp.float64(1.0))
 
 
 @wp.kernel
-def group_listed_points(count: wp.array(dtype=wp.int32), groups: wp.array(dtype=wp.int32)):
-    """groups[k] = 0 for the listed points (k < count[0]), 1 for the rest of the list's capacity: the groups of a hash
-    built over the whole capacity, whose searches then meet the listed points only (a captured step, whose launch
-    sizes cannot depend on the count)."""
+def group_listed_points(cls_count: wp.array(dtype=wp.int32), cls: wp.int32, groups: wp.array(dtype=wp.int32)):
+    """groups[k] = 0 for the listed points of size class ``cls`` (k < cls_count[cls]), 1 for the rest of the list's
+    capacity: the groups of a hash built over the whole capacity, whose searches then meet the listed points only (a
+    captured step, whose launch sizes cannot depend on the count)."""
     k = wp.tid()
-    groups[k] = wp.where(k < count[0], 0, 1)
+    groups[k] = wp.where(k < cls_count[cls], 0, 1)
 
 
 @wp.kernel
 def eval_particle_edge_contact(
-    grid: wp.uint64,
-    elems: wp.array(dtype=wp.int32),
-    points: wp.array(dtype=wp.vec3d),
+    grid_small: wp.uint64,
+    grid_large: wp.uint64,
+    cls_count: wp.array(dtype=wp.int32),
+    cls_elems: wp.array(dtype=wp.int32),
+    cls_points: wp.array(dtype=wp.vec3d),
     slot_iface: wp.array(dtype=wp.int32),
     pair_mode: wp.array(dtype=wp.int32),
     x_rock: wp.array(dtype=wp.vec2d),
@@ -103,8 +126,9 @@ def eval_particle_edge_contact(
     zeta: wp.float64,
     mu: wp.float64,
     r_max: wp.float64,
-    reach_max: wp.array(dtype=wp.float64),
+    reach: wp.array(dtype=wp.float64),
     query_margin: wp.float64,
+    split: wp.float64,
     dt: wp.float64,
     surface: wp.float64,
     preload: wp.float64,
@@ -127,11 +151,15 @@ def eval_particle_edge_contact(
     """Contact force on each particle (assigned to f_p) and its reactions on the rock nodes (added to f_react,
     which the step adds to the rock's forces: coupler.add_reactions), METHOD §3.
 
-    points: the listed elements' centroids at the last rebuild, their reach as z [m] (collect_exposed_elements).
-    The search radius is reach_max[0] (the largest reach in the list, written by collect_exposed_elements) +
-    query_margin [m], read here, so that a rebuild reads nothing back. The search asks for group 0: a hash built over
-    the list's whole capacity (a captured step, GasRockCoupler) holds the listed points as group 0, and a hash of the
-    listed points alone has no groups, so it meets them all, in the same order.
+    cls_points, cls_elems, cls_count: the listed elements by size class (collect_exposed_elements): centroids at the
+    last rebuild with their reach as z [m], elements, counts. Two searches: the small elements' hash (grid_small)
+    within ``split`` [m] (their reach + query_margin is within it) or the largest search radius where that is less
+    (split = ∞: one class), then, where there are any, the large
+    ones' (grid_large) within reach[REACH_MAX] + query_margin [m] (the list's largest reach, read here, so that a
+    rebuild reads nothing back): the few large blocks of a coarse far mesh no longer widen every particle's search.
+    Each search asks for group 0: a hash built over the list's whole capacity (a captured step, GasRockCoupler) holds
+    the listed points as group 0, and a hash of the listed points alone has no groups, so it meets them all, in the
+    same order.
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
     each (8·element + feature, ignored initial overlap δ₀ [m], effective overlap δ − δ₀ [m]); feature 0–2:
     edge k, 3–5: vertex k; −1 marks an empty slot.
@@ -162,88 +190,95 @@ def eval_particle_edge_contact(
     stored = wp.float64(0.0)
     qsum = wp.float64(0.0)
     ncon = int(0)
-    query_radius = reach_max[0] + query_margin
-    query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius, 0)
-    idx = int(0)
-    while wp.hash_grid_query_next(query, idx):
-        # the hash returns whole cells: skip elements whose reach (from the centroid listed at the last rebuild,
-        # with the same allowance for motion as the search radius; the point's z) cannot meet the particle's
-        # contact disk, before loading anything else of them
-        c = points[idx]
-        dx = xp[0] - c[0]
-        dy = xp[1] - c[1]
-        lim = c[2] + rc
-        if dx * dx + dy * dy > lim * lim:
+    for cls in range(2):
+        if cls_count[cls] == 0:                   # (an empty class's hash may hold an older list)
             continue
-        e = elems[idx]
-        best = wp.float64(-1.0)
-        bn = wp.vec2d(zero, zero)
-        ia = int(-1)
-        ib = int(-1)
-        bk = int(-1)
-        bxi = wp.float64(0.0)
-        for k in range(3):
-            s = 3 * e + k
-            if slot_exposed(s, slot_iface, pair_mode):
-                b = 3 * e + (k + 1) % 3
-                de, ne, xie = edge_overlap(xp, rc, x_rock[s], x_rock[b])
-                if de > best:
-                    best = de
-                    bn = ne
-                    ia = s
-                    ib = b
-                    bk = k
-                    bxi = xie
-        for k in range(3):
-            a = 3 * e + k
-            if slot_exposed(a, slot_iface, pair_mode) or slot_exposed(3 * e + (k + 2) % 3, slot_iface, pair_mode):
-                dv, nv = vertex_overlap(xp, rc, x_rock[a])
-                if dv > best:
-                    best = dv
-                    bn = nv
-                    ia = a
-                    ib = a
-                    bk = 3 + k
-                    bxi = zero
-        if best > zero:
-            wa = one - bxi
-            mc = wa * m_rock[ia] + bxi * m_rock[ib]
-            vc = wa * v_rock[ia] + bxi * v_rock[ib]
-            cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
-            arm = -surface * rp * bn                       # contact point (disk surface) − particle centre [m]
-            vrel = vp + Lp * arm - vc                      # gas velocity at the contact point − wall velocity
-            # initial overlap δ₀ (ignored part of the overlap): kept from the last step's contact with element e, else
-            # what a new contact cannot explain. The deepest feature of an element (edge or vertex bk) can change,
-            # e.g. for a particle an element rotated over; δ₀ belonged to the old feature, so it is re-based to keep
-            # the force continuous, δ₀ = δ − (δ − δ₀)_last. (Reusing it against the new feature made the force jump
-            # by k_c times the difference, 140 µm once in a single-hole blast, and the run went unstable; treating
-            # the switch as a new contact gave the slack k_c·0.1r_p for free at every switch.)
-            key = 8 * e + bk
-            d0 = wp.float64(-1.0)
-            for h in range(CONTACT_HISTORY):
-                he = hist_e_in[h0 + h]
-                if he == key:
-                    d0 = wp.min(hist_d_in[h0 + h], best)
-                elif he >= 0 and he // 8 == e:
-                    d0 = wp.max(best - hist_x_in[h0 + h], zero)
-            if d0 < zero:
-                d0 = initial_overlap(best, wp.dot(vrel, bn), dt, rp)
-            if ncon < CONTACT_HISTORY:
-                hist_e_out[h0 + ncon] = key
-                hist_d_out[h0 + ncon] = d0
-                hist_x_out[h0 + ncon] = best - d0
-            best = best - d0
-            fcap = wp.float64(0.0)
-            if kappa > zero:
-                fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
-            f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
-            qsum = qsum + pw
-            fsum = fsum + f
-            msum = msum + wp.outer(f, arm)
-            wp.atomic_add(f_react, ia, -wa * f)
-            wp.atomic_add(f_react, ib, -bxi * f)
-            stored = stored + wp.float64(0.5) * kc * best * best
-            ncon = ncon + 1
+        grid = wp.where(cls == SMALL, grid_small, grid_large)
+        first = cls * (cls_points.shape[0] // 2)       # class c from c·(elements) on
+        query_radius = reach[REACH_MAX] + query_margin
+        if cls == SMALL:
+            query_radius = wp.min(split, query_radius)
+        query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius, 0)
+        idx = int(0)
+        while wp.hash_grid_query_next(query, idx):
+            # the hash returns whole cells: skip elements whose reach (from the centroid listed at the last rebuild,
+            # with the same allowance for motion as the search radius; the point's z) cannot meet the particle's
+            # contact disk, before loading anything else of them
+            c = cls_points[first + idx]
+            dx = xp[0] - c[0]
+            dy = xp[1] - c[1]
+            lim = c[2] + rc
+            if dx * dx + dy * dy > lim * lim:
+                continue
+            e = cls_elems[first + idx]
+            best = wp.float64(-1.0)
+            bn = wp.vec2d(zero, zero)
+            ia = int(-1)
+            ib = int(-1)
+            bk = int(-1)
+            bxi = wp.float64(0.0)
+            for k in range(3):
+                s = 3 * e + k
+                if slot_exposed(s, slot_iface, pair_mode):
+                    b = 3 * e + (k + 1) % 3
+                    de, ne, xie = edge_overlap(xp, rc, x_rock[s], x_rock[b])
+                    if de > best:
+                        best = de
+                        bn = ne
+                        ia = s
+                        ib = b
+                        bk = k
+                        bxi = xie
+            for k in range(3):
+                a = 3 * e + k
+                if slot_exposed(a, slot_iface, pair_mode) or slot_exposed(3 * e + (k + 2) % 3, slot_iface, pair_mode):
+                    dv, nv = vertex_overlap(xp, rc, x_rock[a])
+                    if dv > best:
+                        best = dv
+                        bn = nv
+                        ia = a
+                        ib = a
+                        bk = 3 + k
+                        bxi = zero
+            if best > zero:
+                wa = one - bxi
+                mc = wa * m_rock[ia] + bxi * m_rock[ib]
+                vc = wa * v_rock[ia] + bxi * v_rock[ib]
+                cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
+                arm = -surface * rp * bn                       # contact point (disk surface) − particle centre [m]
+                vrel = vp + Lp * arm - vc                      # gas velocity at the contact point − wall velocity
+                # initial overlap δ₀ (ignored part of the overlap): kept from the last step's contact with element e, else
+                # what a new contact cannot explain. The deepest feature of an element (edge or vertex bk) can change,
+                # e.g. for a particle an element rotated over; δ₀ belonged to the old feature, so it is re-based to keep
+                # the force continuous, δ₀ = δ − (δ − δ₀)_last. (Reusing it against the new feature made the force jump
+                # by k_c times the difference, 140 µm once in a single-hole blast, and the run went unstable; treating
+                # the switch as a new contact gave the slack k_c·0.1r_p for free at every switch.)
+                key = 8 * e + bk
+                d0 = wp.float64(-1.0)
+                for h in range(CONTACT_HISTORY):
+                    he = hist_e_in[h0 + h]
+                    if he == key:
+                        d0 = wp.min(hist_d_in[h0 + h], best)
+                    elif he >= 0 and he // 8 == e:
+                        d0 = wp.max(best - hist_x_in[h0 + h], zero)
+                if d0 < zero:
+                    d0 = initial_overlap(best, wp.dot(vrel, bn), dt, rp)
+                if ncon < CONTACT_HISTORY:
+                    hist_e_out[h0 + ncon] = key
+                    hist_d_out[h0 + ncon] = d0
+                    hist_x_out[h0 + ncon] = best - d0
+                best = best - d0
+                fcap = wp.float64(0.0)
+                if kappa > zero:
+                    fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
+                f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
+                qsum = qsum + pw
+                fsum = fsum + f
+                msum = msum + wp.outer(f, arm)
+                wp.atomic_add(f_react, ia, -wa * f)
+                wp.atomic_add(f_react, ib, -bxi * f)
+                stored = stored + wp.float64(0.5) * kc * best * best
+                ncon = ncon + 1
     f_p[p] = fsum
     fm_p[p] = msum
     work = work + w_new * contact_power(fsum, msum, vp, Lp)         # this step's forces, their first half

@@ -172,5 +172,6 @@ def _rebuild_hashes(sim) -> None:
         c.grid.build(c.points, c.radius)                  # wp.HashGrid (fan_cache off); the cell grid is saved
     cp = getattr(sim, "coupler", None)
     if cp is not None and cp._since < cp.rebuild_interval:
-        cp.n_exposed, cp._count_stale = int(cp.count.numpy()[0]), False     # captured steps may have changed it
+        cp._count_stale = True                            # captured steps may have changed the counts
+        cp._read_count()
         cp.build_hash()
