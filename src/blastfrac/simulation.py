@@ -276,7 +276,7 @@ class Simulation:
                 (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
             return False
         rest = (id(self.state), dt, self.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
-                self.wall_load is not None)
+                cp.cell_size, cp.cell_large, cp.split, self.wall_load is not None)     # (graphs dropped on a change)
         if rest != self._cgraphs_key:
             self._cgraphs, self._cgraphs_key = {}, rest
         cg = self.crack_gas

@@ -52,19 +52,27 @@ def _state(sim) -> dict:
     return out
 
 
-@pytest.mark.parametrize("crack_gas", [False, True], ids=["particles", "crack_gas"])
-def test_captured_coupled_steps_are_bit_identical(tmp_path, crack_gas):
+@pytest.mark.parametrize("crack_gas, two_hashes", [(False, False), (True, False), (False, True)],
+                         ids=["particles", "crack_gas", "two_hashes"])
+def test_captured_coupled_steps_are_bit_identical(tmp_path, monkeypatch, crack_gas, two_hashes):
     """With crack gas the network's rebuilds, flows, mouths and hand-overs to the particles run inside the graph
-    too (its counts on the device, its branches through wp.capture_if)."""
+    too (its counts on the device, its branches through wp.capture_if). With ``two_hashes`` the coupler's split is
+    lowered (CELL_REACH), so that its listed elements fall in two size classes with a hash each, as a coarse far
+    mesh's cracked blocks do in the demo; this small case keeps one class otherwise."""
+    if two_hashes:
+        import blastfrac.coupling.coupler as coupler
+
+        monkeypatch.setattr(coupler, "CELL_REACH", 0.5)
     ref, cap = (Simulation(scenario_from_dict(_scenario(g, crack_gas)), out_dir=tmp_path / g) for g in ("off", "on"))
     if ref.model.device != "cpu":
         pytest.skip("bit-identity is a CPU property")
     assert not ref.coupled_graph and cap.coupled_graph
-    steps, dts, boxes, listed, rebuilds = 700, set(), set(), set(), 0
+    steps, dts, boxes, listed, rebuilds, large = 700, set(), set(), set(), 0, 0
     for k in range(steps):
         rebuilds += cap.coupler._since >= cap.coupler.rebuild_interval
         ref.step()
         cap.step()
+        large = max(large, int(cap.coupler.cls_count.numpy()[1]))
         dts.add(cap.dt)
         boxes.add(cap.gas.grid.box)
         listed.add(ref.coupler.n_exposed)
@@ -77,7 +85,7 @@ def test_captured_coupled_steps_are_bit_identical(tmp_path, crack_gas):
     mode = cap.state.pair_mode.numpy()
     print(f"\n  {cap.coupled_graph_steps} of {steps} steps replayed, {cap.coupled_graph_captures} graphs captured, "
           f"{len(cap._cgraphs)} held; {len(dts)} time "
-          f"steps, {len(boxes)} MPM boxes, {rebuilds} list rebuilds, {len(listed)} list lengths; {int(np.count_nonzero(mode))} springs broken, "
+          f"steps, {len(boxes)} MPM boxes, {rebuilds} list rebuilds, {len(listed)} list lengths, up to {large} large; {int(np.count_nonzero(mode))} springs broken, "
           f"{cap.coupler.n_exposed} listed elements; warnings {cap.warnings}")
     assert ref.coupled_graph_steps == 0
     assert not cap.warnings
@@ -86,6 +94,7 @@ def test_captured_coupled_steps_are_bit_identical(tmp_path, crack_gas):
     # through Δt changes, box renewals, rebuilds of the coupler's list whose length the graph never reads
     assert len(dts) > 2 and len(boxes) > 1 and rebuilds > 50 and len(listed) > 2
     assert np.count_nonzero(mode) > 50                   # and fracture
+    assert (large > 0) == two_hashes                     # the large elements' hash was searched, or not
     if crack_gas:                                        # gas in the cracks, fed through mouths
         assert cap.crack_gas.gas.mass.numpy().sum() > 0 and cap.crack_gas.report()["mouths"] > 0
 
