@@ -39,8 +39,8 @@ def contact_power(f: wp.vec2d, M: wp.mat22d, v: wp.vec2d, L: wp.mat22d):
 REACH_MAX = 0
 REACH_SUM = 1
 REACH_COUNT = 2
-#: the listed elements' size classes, each with its own hash: small (reach + margin within the small hash's cell,
-#: found by a search one cell wide) and large (found by a search of the largest reach)
+#: the listed elements' size classes, each with its own hash: small (reach + margin within the coupler's split, found
+#: by a search that wide) and large (found by a search of the largest reach); GasRockCoupler.note_reach
 SMALL = 0
 LARGE = 1
 
@@ -154,9 +154,9 @@ def eval_particle_edge_contact(
     cls_points, cls_elems, cls_count: the listed elements by size class (collect_exposed_elements): centroids at the
     last rebuild with their reach as z [m], elements, counts. Two searches: the small elements' hash (grid_small)
     within ``split`` [m] (their reach + query_margin is within it) or the largest search radius where that is less
-    (split = ∞: one class), then, where there are any, the large
-    ones' (grid_large) within reach[REACH_MAX] + query_margin [m] (the list's largest reach, read here, so that a
-    rebuild reads nothing back): the few large blocks of a coarse far mesh no longer widen every particle's search.
+    (split = ∞: one class), then, where there are any, the large ones' (grid_large) within reach[REACH_MAX] +
+    query_margin [m] (the list's largest reach, read here, so that a rebuild reads nothing back): the few large
+    blocks of a coarse far mesh no longer widen every particle's search.
     Each search asks for group 0: a hash built over the list's whole capacity (a captured step, GasRockCoupler) holds
     the listed points as group 0, and a hash of the listed points alone has no groups, so it meets them all, in the
     same order.
