@@ -23,6 +23,7 @@ from .analysis.fracture import FractureDegree, joint_spring_mask
 from .analysis.monitors import MonitorSet
 from .blowup import diagnose_nonfinite
 from .cdem.solver import CDEMSolver
+from .coupled_graph import CoupledGraphs
 from .io.paraview import GasSeries, ParaviewSeries, crack_segments, joint_segments
 from .io.tables import CsvHistory, monitor_unit, write_summary
 from .model.builder import ModelBuilder
@@ -33,11 +34,6 @@ from .scenario.schema import Scenario
 
 
 _BUDGET_MIN_STEPS = 50      # energy-budget samples before this step are not checked against output.budget_warning
-#: steps a coupled step runs through the launches after Δt changed, before it is captured (Δt is re-estimated every
-#: 10 steps; while the gas sets it, early in a blast, most estimates change it, and a graph captured for one value
-#: would serve ~10 steps: on a CPU the 10 mm confined P0's first 300 steps took 1.27 s captured at every change,
-#: against 0.57 s through the launches)
-DT_SETTLED = 20
 
 
 class SimulationError(RuntimeError):
@@ -77,12 +73,11 @@ class Simulation:
         self._rock_after = None                                        # nothing after a rock step (graph key)
         # rock-only steps (no gas, or gas frozen) are replayed from a captured graph where they can be
         # (CDEMSolver.step_captured: bit-identical; False runs every step through the launches), and coupled steps
-        # with simulation.graph = 'on', or 'auto' on a GPU (_step_coupled_captured)
+        # with simulation.graph = 'on', or 'auto' on a GPU (coupled_graph.py)
         graph = scenario.simulation.graph
         self.use_graph = graph != "off"
         self.coupled_graph = graph == "on" or (graph == "auto" and self.device != "cpu")
-        self._cgraphs: dict = {}                            # captured coupled steps by the coupler's key
-        self._cgraphs_key = None                            # ... all for this key of the rest
+        self.graphs = CoupledGraphs()                       # captured coupled steps (coupled_graph.py)
         self.coupled_graph_steps = 0                        # coupled steps replayed from a graph
         self.coupled_graph_captures = 0                     # ... and graphs captured
         self._dt_since = 0                                  # the step at which Δt last changed
@@ -225,7 +220,7 @@ class Simulation:
             self.cdem.pool = self._pool if self._parallel else None
         if not couple and self.use_graph and self.cdem.step_captured(st, dt, self.time, self.alpha, self._rock_after):
             pass                                           # the rock step below, replayed from a captured graph
-        elif graph and self._step_coupled_captured(dt):
+        elif graph and self.graphs.step(self, dt):
             pass                                           # the coupled step below, replayed from a captured graph
         elif couple:
             self.cdem.forces_springs_blocks(st, dt, self.time)   # springs + failure (this step's pair_mode), CST
@@ -254,85 +249,6 @@ class Simulation:
             self.dt = dt_new
         if self.cdem.contact is not None and not self.cdem.contact.active and self.steps % 16 == 0:
             self.cdem.contact.active = self.cdem.contact.any_dropped(self.state)
-
-    def _step_coupled_captured(self, dt: float) -> bool:
-        """One coupled step replayed from a captured graph (a CUDA graph on a GPU, Warp's replay of the recorded
-        operations on a CPU): the launches of the one-thread step (rock forces, gas forces beside them, the gas loads,
-        integration, the gas's advance), which read nothing back inside it. The clocks (the time at the start of the
-        step, which the springs and the burn read) and the pulses are set before the replay, and the host's side of
-        the step runs beside it: the schedules and history buffers of the coupler and the crack gas (``host_step``),
-        the MPM box's renewal every BOX_STEPS steps (MPMSolver.advance_box). A graph is kept for each of their keys
-        (rebuild or not, history buffer: four without crack gas) and all are captured again when anything else they
-        hold changes: Δt (set by the host every 10 steps; in the shipped examples it settles within their first
-        250–450 steps), the MPM box, block contact's settings.
-
-        Returns False, having done nothing, where a graph cannot stand for the step: within DT_SETTLED steps of the
-        start or of a change of Δt (while the gas sets Δt, early in a blast, most of its estimates change it, and a
-        graph would serve a few steps for the cost of its capture), before the first passes of block contact and
-        the coupler (they build their caches on the host), with pulses on a GPU (CDEMSolver.step_captured), and
-        from a failed capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
-        m, c, cp, gas = self.model, self.cdem.contact, self.coupler, self.gas
-        if cp.cell_size == 0.0 or self.cdem.dt_prev != dt or self.steps - self._dt_since < DT_SETTLED or \
-                (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
-            return False
-        rest = (id(self.state), dt, self.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
-                cp.cell_size, cp.cell_large, cp.split, self.wall_load is not None)     # (graphs dropped on a change)
-        if rest != self._cgraphs_key:
-            self._cgraphs, self._cgraphs_key = {}, rest
-        cg = self.crack_gas
-        key = (cp.graph_key(), None if cg is None else cg.graph_key())
-        t = self.time
-        self.cdem.pool = None
-        self._parallel = False
-        graph = self._cgraphs.get(key)
-        self.cdem._set_clock(t)
-        gas.set_clock(t)
-        if graph is None:
-            saved = (cp._since, cp._dt_work, cp._w_react, list(cp._hist), None if cg is None else (cg._since, cg._dt_prev))
-            try:
-                graph = self._capture_coupled(dt)
-            except Exception as err:                 # noqa: BLE001 (the launches can always take the step)
-                cp._since, cp._dt_work, cp._w_react, cp._hist = saved[:4]  # as before the captured host steps
-                if cg is not None:
-                    cg._since, cg._dt_prev = saved[4]
-                self.coupled_graph = False
-                self.warnings.append(f"coupled steps run through the launches: capturing one failed ({err})")
-                return False
-            self._cgraphs[key] = graph
-            self.coupled_graph_captures += 1
-        else:
-            if m.pulses:
-                self.cdem.eval_pulses(t)             # the graph copies this host buffer
-            cp.host_step(dt)                         # what the captured stages did on the host
-            if cg is not None:
-                cg.host_step(dt)
-        wp.capture_launch(graph)
-        gas.advance_box()
-        self.coupled_graph_steps += 1
-        return True
-
-    def _capture_coupled(self, dt: float):
-        """Capture the one-thread coupled step's launches (``step``'s order) as a graph, without running them."""
-        st, t, d = self.state, self.time, self.model.device
-        stages = [s for s in (self.coupler, self.gas, self.crack_gas) if s is not None]
-        for s in stages:
-            s.captured = True
-        self.cdem._capturing = True
-        wp.capture_begin(device=d)
-        try:
-            self.cdem.forces_springs_blocks(st, dt, t)
-            self.cdem.forces_rest(st, dt, t, beside=lambda: self._gas_forces(dt), blocks_done=True)
-            self.coupler.add_reactions(st)
-            if self.crack_gas is not None:
-                self.crack_gas.add_loads(st)
-            self.cdem.integrate(st, dt, self.alpha)
-            self._gas_advance(dt)
-        finally:
-            for s in stages:
-                s.captured = False
-            self.cdem._capturing = False
-            graph = wp.capture_end(device=d)
-        return graph
 
     def _gas_forces(self, dt: float) -> None:
         """Particle–edge contact (gas f_ext_p, rock reactions into f_react), wall load, crack gas, P2G, grid."""
@@ -365,75 +281,11 @@ class Simulation:
 
     # ------------------------------------------------------------------ in-situ stage
     def relax_insitu(self, progress=None) -> dict:
-        """Initialise σ⁰, apply consistent tractions and relax quasi-statically (METHOD §1.8)."""
-        ins = self.scenario.insitu
-        self.cdem.initialise_stress(self.state, ins.sxx, ins.syy, ins.sxy)
-        steps, converged, ratio = 0, ins.method == "initial", float("nan")
-        breakable = self.model.breakable
-        if not ins.allow_failure:
-            self.model.breakable = 0
-        saved_alpha, self.alpha = self.alpha, ins.damping
-        # at least two P-wave transits of the domain before the criterion is trusted
-        span = float(np.ptp(self.model.host["node_X"], axis=0).max())
-        min_steps = int(2 * span / self.scenario.rock.p_wave_speed / self.dt) + 1
-        limit = ins.max_steps if self.max_steps is None else min(ins.max_steps, self.max_steps)   # --max-steps too
-        task = progress.add_task("in-situ relaxation", total=limit) if progress else None
-        while not converged and steps < limit:
-            self.step(gas=False)
-            steps += 1
-            if steps % 200 == 0:
-                e = rock_energies(self.model, self.state)
-                ratio = e["kinetic"] / max(e["strain"] + e["springs"], 1e-300)
-                self._guard(e)
-                converged = steps >= min_steps and ratio < ins.tolerance
-                if task is not None:
-                    progress.update(task, completed=steps, description=f"in-situ relaxation (KE/U {ratio:.1e})")
-        if task is not None:
-            progress.update(task, completed=limit)
-        if not converged:
-            msg = (f"in-situ stage did not converge: KE/U = {ratio:.2e} after {steps} steps (insitu.tolerance "
-                   f"{ins.tolerance:g}, limit {limit}" + (" from --max-steps" if limit < ins.max_steps else
-                                                         " = insitu.max_steps") + "); the blast starts from a "
-                   "state that is still moving: raise insitu.max_steps, or check insitu.damping")
-            self.warnings.append(msg)
-            print(f"warning: {msg}", file=sys.stderr, flush=True)
-        self.model.breakable, self.alpha = breakable, saved_alpha
-        t_relax = self.time
-        tb = self.state.pair_tbreak.numpy().copy()
-        mode = self.state.pair_mode.numpy()
-        tb[mode > 0] -= t_relax                      # pre-stress failures get negative break times
-        self.state.pair_tbreak.assign(tb)
-        self.state.v.zero_()
-        self.state.energy_acc.zero_()
-        self.state.pair_damp.zero_()
-        self.state.elem_damp.zero_()
-        self.state.elem_absorbed.zero_()
-        self.ppv.ppv.zero_()                         # vibration is the blast's, not the relaxation's
-        self.cdem.dt_prev = 0.0
-        self.initial_dissipated = self.cdem.rebase_spring_work(self.state)
-        e = rock_energies(self.model, self.state)
-        self.initial_stored = e["strain"] + e["springs"]
-        counts = self.fracture.counts(mode)
-        # intact springs already on their softening branch (fracture energies given): damaged, not broken
-        s_now, h = self.state.pair_str.numpy(), self.model.host
-        softening = (mode == 0) & ((s_now[:, 0] < h["pair_t0"] * (1 - 1e-9)) | (s_now[:, 1] < h["pair_c0"] * (1 - 1e-9)))
-        self.insitu_report = {
-            "method": ins.method, "steps": steps, "pseudo_time": t_relax, "converged": bool(converged),
-            "kinetic_to_strain_ratio": ratio, "broken_tensile": counts["tensile"], "broken_shear": counts["shear"],
-            "broken_crushed": counts["crushed"],
-            "softening": int(softening.sum()), "failures_allowed": ins.allow_failure, "wall_check": self._kirsch_check(),
-        }
-        self.time, self.steps = 0.0, 0
-        return self.insitu_report
+        """Initialise σ⁰, apply consistent tractions and relax quasi-statically (METHOD §1.8; insitu_stage.py);
+        returns the stage's report (summary.json → insitu_stage)."""
+        from .insitu_stage import relax_insitu
 
-    def _kirsch_check(self) -> list[dict]:
-        """Hoop stress on each borehole wall after the in-situ stage against Kirsch (analysis.insitu)."""
-        from .analysis.insitu import wall_stress_check
-
-        ins, rock = self.scenario.insitu, self.scenario.rock
-        x, sig = self.state.x.numpy(), self.state.sigma.numpy()
-        return [wall_stress_check(x, sig, b.center, b.radius, ins.sxx, ins.syy, ins.sxy, rock.tensile_strength)
-                for b in self.scenario.geometry.boreholes]
+        return relax_insitu(self, progress)
 
     # ------------------------------------------------------------------ run loop
     def run(self, progress: bool | None = None, restart: str | Path | None = None) -> dict:

@@ -1,4 +1,4 @@
-"""The captured coupled step (Simulation._step_coupled_captured, issue 14 item 1): a CPU graph replays what the
+"""The captured coupled step (coupled_graph.CoupledGraphs, issue 14 item 1): a CPU graph replays what the
 launches do.
 
 A coupled blast (MPM products expanding from a decoupled charge into its borehole, particle–edge contact, springs that break, block contact, an MPM box
@@ -84,7 +84,7 @@ def test_captured_coupled_steps_are_bit_identical(tmp_path, monkeypatch, crack_g
     assert ref.energies() == cap.energies()
     mode = cap.state.pair_mode.numpy()
     print(f"\n  {cap.coupled_graph_steps} of {steps} steps replayed, {cap.coupled_graph_captures} graphs captured, "
-          f"{len(cap._cgraphs)} held; {len(dts)} time "
+          f"{len(cap.graphs.cache)} held; {len(dts)} time "
           f"steps, {len(boxes)} MPM boxes, {rebuilds} list rebuilds, {len(listed)} list lengths, up to {large} large; {int(np.count_nonzero(mode))} springs broken, "
           f"{cap.coupler.n_exposed} listed elements; warnings {cap.warnings}")
     assert ref.coupled_graph_steps == 0

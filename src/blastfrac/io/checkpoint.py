@@ -37,7 +37,7 @@ SKIP = {"model", "mesh", "scenario", "topology", "builder", "config", "material"
         "_rock_after", "ppv_out", "s_mesh", "s_hash", "s_cache", "s_hist", "s_marks", "s_prm", "s_rec", "_second",
         "_parallel", "rec_nodes", "rec_force", "rec_xi", "rec_energy",
         "_spring_model", "_spring_states", "_spring_scalars", "geo",
-        "_prm_values", "use_graph", "coupled_graph", "_cgraphs", "_cgraphs_key"}
+        "_prm_values", "use_graph", "coupled_graph", "graphs"}
 #: the stage objects hanging from the Simulation (walked as stages, not as its attributes)
 ROOT_STAGES = {"state", "cdem", "coupler", "gas", "crack_gas", "wall_load", "ppv"}
 
