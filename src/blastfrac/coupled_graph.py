@@ -46,7 +46,7 @@ class CoupledGraphs:
                 (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
             return False
         rest = (id(sim.state), dt, sim.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
-                cp.cell_size, cp.cell_large, cp.split, sim.wall_load is not None)     # (graphs dropped on a change)
+                cp.graph_held(), sim.wall_load is not None)     # (graphs dropped on a change)
         if rest != self.key:
             self.cache, self.key = {}, rest
         cg = sim.crack_gas
@@ -58,13 +58,13 @@ class CoupledGraphs:
         sim.cdem._set_clock(t)
         gas.set_clock(t)
         if graph is None:
-            saved = (cp._since, cp._dt_work, cp._w_react, list(cp._hist), None if cg is None else (cg._since, cg._dt_prev))
+            stages = [st for st in (cp, cg) if st is not None]
+            saved = [st.host_state() for st in stages]
             try:
                 graph = self._capture(sim, dt)
             except Exception as err:                 # noqa: BLE001 (the launches can always take the step)
-                cp._since, cp._dt_work, cp._w_react, cp._hist = saved[:4]  # as before the captured host steps
-                if cg is not None:
-                    cg._since, cg._dt_prev = saved[4]
+                for st, h in zip(stages, saved):
+                    st.set_host_state(h)             # as before the captured host steps
                 sim.coupled_graph = False
                 sim.warnings.append(f"coupled steps run through the launches: capturing one failed ({err})")
                 return False
@@ -88,8 +88,10 @@ class CoupledGraphs:
         for s in stages:
             s.captured = True
         sim.cdem._capturing = True
-        wp.capture_begin(device=d)
-        try:
+        begun = False
+        try:                                         # (the stages' flags go back whatever fails, begin included)
+            wp.capture_begin(device=d)
+            begun = True
             sim.cdem.forces_springs_blocks(st, dt, t)
             sim.cdem.forces_rest(st, dt, t, beside=lambda: sim._gas_forces(dt), blocks_done=True)
             sim.coupler.add_reactions(st)
@@ -101,5 +103,5 @@ class CoupledGraphs:
             for s in stages:
                 s.captured = False
             sim.cdem._capturing = False
-            graph = wp.capture_end(device=d)
+            graph = wp.capture_end(device=d) if begun else None
         return graph

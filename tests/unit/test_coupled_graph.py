@@ -133,3 +133,33 @@ def test_the_gpu_form_of_the_dropped_spring_check_reads_the_same(tmp_path):
         on_cpu = c.any_dropped(st)
         c._cpu = False                                   # the GPU form: flag_any_dropped and a 4-byte read
         assert c.any_dropped(st) == on_cpu == bool(dropped)
+
+
+@pytest.mark.parametrize("where", ["begin", "inside"])
+def test_a_failed_capture_falls_back_to_the_launches(tmp_path, monkeypatch, where):
+    """A capture that fails (a GPU without conditional graph nodes, say) leaves the run on the launches with a
+    warning, its stages' flags and host schedules as they were: the run ends where one through the launches ends."""
+    import warp as wp
+
+    ref, cap = (Simulation(scenario_from_dict(_scenario(g, True)), out_dir=tmp_path / g) for g in ("off", "on"))
+    if where == "begin":
+        def fail(*a, **k):
+            raise RuntimeError("no graph here")
+        monkeypatch.setattr(wp, "capture_begin", fail)
+    else:
+        real = cap.coupler._contacts
+
+        def fail_in_capture(*a, **k):
+            if cap.coupler.captured:
+                raise RuntimeError("no conditional nodes")
+            return real(*a, **k)
+        monkeypatch.setattr(cap.coupler, "_contacts", fail_in_capture)
+    for _ in range(300):
+        ref.step()
+        cap.step()
+    assert not cap.coupled_graph and cap.coupled_graph_steps == 0
+    assert len(cap.warnings) == 1 and "capturing one failed" in cap.warnings[0]
+    assert not (cap.coupler.captured or cap.gas.captured or cap.crack_gas.captured or cap.cdem._capturing)
+    a, b = _state(ref), _state(cap)
+    for name in a:
+        assert np.array_equal(a[name], b[name]), name

@@ -272,11 +272,21 @@ class GasRockCoupler:
         return rebuild, w_old, h_in, h_out
 
     def graph_key(self) -> tuple:
-        """What a captured step holds fixed of this stage (Simulation captures again when it changes): whether it
-        rebuilds the list, the buffer its histories come from, the last step's length, the MPM box the list covers
-        and the hashes' cell widths and split."""
-        return (self._since >= self.rebuild_interval, id(self._hist[0][0]), self._dt_work, self.mpm.grid.box,
-                self.cell_size, self.cell_large, self.split)
+        """What a captured step holds fixed of this stage from step to step (a graph for each, coupled_graph.py):
+        whether it rebuilds the list, the buffer its histories come from, the last step's length."""
+        return self._since >= self.rebuild_interval, id(self._hist[0][0]), self._dt_work
+
+    def graph_held(self) -> tuple:
+        """What it holds fixed for longer (every graph is captured again when it changes): the MPM box the list
+        covers, the hashes' cell widths and split."""
+        return self.mpm.grid.box, self.cell_size, self.cell_large, self.split
+
+    def host_state(self) -> tuple:
+        """The host's side of the stage (``host_step`` moves it on), to be put back by ``set_host_state``."""
+        return self._since, self._dt_work, self._w_react, list(self._hist)
+
+    def set_host_state(self, saved: tuple) -> None:
+        self._since, self._dt_work, self._w_react, self._hist = saved[0], saved[1], saved[2], list(saved[3])
 
     def _list_nodes(self) -> int:
         """Threads of a launch over the listed elements' nodes: the list's capacity in a capture, else its length."""

@@ -235,6 +235,13 @@ class CrackGas:
         """What a captured step holds fixed of this stage: whether it rebuilds the network, the last step's length."""
         return self._since >= self.rebuild_interval, self._dt_prev
 
+    def host_state(self) -> tuple:
+        """The host's side of the stage (``host_step`` moves it on), to be put back by ``set_host_state``."""
+        return self._since, self._dt_prev
+
+    def set_host_state(self, saved: tuple) -> None:
+        self._since, self._dt_prev = saved
+
     def apply(self, state, dt: float) -> None:
         """Stage between the particle–edge contact and P2G: cell pressures and face forces (into f_nodes;
         ``add_loads`` adds them to state.f), then this step's flow along the network and at the mouths."""
