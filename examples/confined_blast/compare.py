@@ -20,6 +20,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from blastfrac.analysis.cracks import zone_radii
+
 HERE = Path(__file__).parent
 PRESSURES = (0, 15, 30)
 TENSILE, SHEAR = "#d62728", "#1f77b4"
@@ -55,7 +57,8 @@ def run_numbers(run: Path) -> dict:
         "D": s["fracture_degree"]["D"], "D_tensile": s["fracture_degree"]["D_tensile"],
         "D_shear": s["fracture_degree"]["D_shear"], "parts": parts,
         "D_horizontal_mean": float(horiz), "D_vertical_mean": float(vert),
-        "crushed_zone_radius_over_rb": c["crushed_zone_radius_over_rb"],
+        # r_c by the rule of 2026-12-06 (NaN for older runs), and r_k, which older runs called r_c (docs/results.md)
+        **{k: v for k, v in zone_radii(c).items() if k.endswith("_over_rb")},
         "damaged_zone_radius_over_rb": c.get("damaged_zone_radius_over_rb", float("nan")),  # runs since stop 26
         "radial_crack_count": c["radial_crack_count"], "longest_radial_crack": c["longest_radial_crack"],
         "insitu_broken": (ins.get("broken_tensile", 0) + ins.get("broken_shear", 0)) if ins else 0,
@@ -141,6 +144,7 @@ def main(argv=None) -> None:
             ("mean D parts 1-5 (along x)", lambda n: f"{n['D_horizontal_mean']:.3f}"),
             ("mean D parts 6-10 (along y)", lambda n: f"{n['D_vertical_mean']:.3f}"),
             ("crushed zone r_c/r_b", lambda n: f"{n['crushed_zone_radius_over_rb']:.2f}"),
+            ("dense cracking r_k/r_b", lambda n: f"{n['dense_cracking_radius_over_rb']:.2f}"),
             ("damaged zone r_d/r_b", lambda n: f"{n['damaged_zone_radius_over_rb']:.2f}"),
             ("radial cracks (max N(R))", lambda n: f"{n['radial_crack_count']}"),
             ("longest radial crack [mm]", lambda n: f"{n['longest_radial_crack'] * 1e3:.0f}"),

@@ -31,6 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
+from blastfrac.analysis.cracks import zone_radii
+
 HERE = Path(__file__).parent
 SCENARIO = HERE.parent / "symmetry" / "scenario_P0_quarter.toml"
 SHIP = ["geometry.mesh_size=0.0025", "geometry.mesh_size_near=0.001"]
@@ -74,15 +76,16 @@ def run(names: list[str], out: Path) -> None:
 def numbers(d: Path) -> dict:
     s = json.loads((d / "summary.json").read_text())
     c = s["cracks"][0]
-    return {"blocks": s["counts"]["elements"], "rc": c["crushed_zone_radius_over_rb"],
-            "longest": 1e3 * c["longest_radial_crack"],
-            "tip": 1e3 * (c["longest_radial_crack"] + c["crushed_zone_radius"]),
+    z = zone_radii(c)            # the study's r_c was the rule now called r_k; the tip is measured from r_k
+    return {"blocks": s["counts"]["elements"], "rc": z["dense_cracking_radius_over_rb"],
+            "rc_new": z["crushed_zone_radius_over_rb"], "longest": 1e3 * c["longest_radial_crack"],
+            "tip": 1e3 * (c["longest_radial_crack"] + z["dense_cracking_radius"]),
             "n_rad": c["radial_crack_count"], "conn": c["connected_crack_length"], "total": c["crack_length_total"],
             "r90": 1e3 * c["crack_extent_r90"], "detached": c["detached_crack_sets"], "D": s["fracture_degree"]["D"],
             "wall": s["wall_time_s"]}
 
 
-COLS = (("blocks", "blocks", "{:d}"), ("rc", "r_c/r_b", "{:.2f}"), ("rd", "r_d/r_b", "{:.2f}"), ("longest", "longest from r_c [mm]", "{:.1f}"),
+COLS = (("blocks", "blocks", "{:d}"), ("rc", "r_k/r_b", "{:.2f}"), ("rd", "r_d/r_b", "{:.2f}"), ("longest", "longest from r_k [mm]", "{:.1f}"),
         ("tip", "its tip from the centre [mm]", "{:.1f}"), ("n_rad", "N_rad (quarter)", "{:d}"),
         ("conn", "connected length [m]", "{:.2f}"), ("total", "all cracks [m]", "{:.2f}"), ("r90", "r90 [mm]", "{:.0f}"),
         ("detached", "detached sets", "{:d}"), ("D", "D", "{:.4f}"), ("wall", "wall [s]", "{:.0f}"))
@@ -166,7 +169,7 @@ def figure(rows: dict, prof: dict) -> None:
         a.set_aspect("equal")
         a.set_xlabel("x [mm]")
         r = rows[n]
-        a.set_title(f"{n} ({r['blocks']:,} blocks)\nr_c/r_b {r['rc']:.2f}, r_d/r_b {r['rd']:.2f}, longest crack tip at {r['tip']:.0f} mm",
+        a.set_title(f"{n} ({r['blocks']:,} blocks)\nr_k/r_b {r['rc']:.2f}, r_d/r_b {r['rd']:.2f}, longest crack tip at {r['tip']:.0f} mm",
                     fontsize=9)
     a = ax[0][-1]
     for n, ls in zip(names, ("-", "--", "-", "--")):

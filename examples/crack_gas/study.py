@@ -457,8 +457,11 @@ def near_radial_stress(run_dir: Path) -> tuple[np.ndarray, np.ndarray]:
 
 
 def case_metrics(run_dir: Path, wall_s: float) -> dict:
+    from blastfrac.analysis.cracks import zone_radii
+
     s = json.loads((run_dir / "summary.json").read_text())
     c = s["cracks"][0]
+    z = zone_radii(c)
     e = s["energy"]
     m = {
         "radial_crack_count": c["radial_crack_count"],
@@ -471,12 +474,13 @@ def case_metrics(run_dir: Path, wall_s: float) -> dict:
         "crack_length_total_m": c["crack_length_total"],
         "connected_crack_length_m": c["connected_crack_length"],
         "detached_crack_sets": c["detached_crack_sets"], "detached_crack_length_m": c["detached_crack_length"],
-        "crushed_zone_radius_over_rb": c["crushed_zone_radius_over_rb"],
-        # the tips' radii from the hole centre, R_k = length + r_c (r_c differs between cases)
-        "longest_tip_radius_mm": 1e3 * (c["longest_radial_crack"] + c["crushed_zone_radius"]),
-        "mean_tip_radius_mm": 1e3 * (c["mean_radial_crack_length"] + c["crushed_zone_radius"])
+        "crushed_zone_radius_over_rb": z["crushed_zone_radius_over_rb"],
+        # the tips' radii from the hole centre, R_k = length + r_k (the lengths start at the dense-cracking radius
+        # r_k, which differs between cases; docs/results.md)
+        "longest_tip_radius_mm": 1e3 * (c["longest_radial_crack"] + z["dense_cracking_radius"]),
+        "mean_tip_radius_mm": 1e3 * (c["mean_radial_crack_length"] + z["dense_cracking_radius"])
         if c["radial_crack_lengths"] else 0.0,
-        "crushed_zone_radius_mm": 1e3 * c["crushed_zone_radius"],
+        "dense_cracking_radius_mm": 1e3 * z["dense_cracking_radius"],
         "D": s["fracture_degree"]["D"], "D_tensile": s["fracture_degree"]["D_tensile"],
         "D_shear": s["fracture_degree"]["D_shear"],
         "budget_error_relative": e["budget_error_relative"],
@@ -659,10 +663,11 @@ def fig_lengths(results: dict, path: Path) -> None:
                 lab = f"({k}) {CASES.get(k[0], '')}{' (mesh 2)' if k.endswith('_p') else ''}"
                 cr = mm["crossings"]
                 a0.plot(cr["radius_mm"], cr["count"], color=col, ls=ls, lw=1.2, label=lab)
-                L = np.asarray(mm["radial_crack_lengths_mm"]) + mm["crushed_zone_radius_mm"]
+                L = np.asarray(mm["radial_crack_lengths_mm"]) + mm.get("dense_cracking_radius_mm",
+                                                                       mm.get("crushed_zone_radius_mm"))
                 a1.plot(np.arange(1, len(L) + 1), L, color=col, ls=ls, marker=".", ms=3, lw=1.1,
                         label=f"({k}): {len(L)} cracks, mean tip radius {mm['mean_tip_radius_mm']:.0f} mm, "
-                              f"r_c {mm['crushed_zone_radius_mm']:.0f} mm")
+                              f"r_k {mm.get('dense_cracking_radius_mm', mm.get('crushed_zone_radius_mm')):.0f} mm")
             a0.set_title(f"{EXAMPLES[ex]['label']}: {title}", fontsize=9.5)
             a0.set_xlabel("R [mm]")
             a0.set_ylabel("connected cracks crossing R, N(R)")

@@ -33,7 +33,9 @@ def blast(factor: float, scale: float, out: Path) -> dict:
     sc = small_blast({"crushing_strength": factor * UCS} if factor > 0 else None, scale=scale, paraview=False)
     s = Simulation(sc, out_dir=out).run()
     c = s["cracks"][0]
-    return {"factor": factor, "scale": scale, "rc": c["crushed_zone_radius_over_rb"], "radial": c["radial_crack_count"],
+    # rc: the rule this study was made with (now the dense-cracking radius r_k); rc_crushed: r_c of 2026-12-06
+    return {"factor": factor, "scale": scale, "rc": c["dense_cracking_radius_over_rb"],
+            "rc_crushed": c["crushed_zone_radius_over_rb"], "radial": c["radial_crack_count"],
             "longest_mm": c["longest_radial_crack"] * 1e3, "broken": s["broken_springs"]}
 
 

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import numpy as np
 
+from blastfrac.analysis.cracks import zone_radii
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 NAMES = ("full", "half", "quarter")
@@ -75,7 +77,7 @@ def main(dirs: list[Path]) -> dict:
             "mean_D_parts_1_5": round(float(np.mean(parts[:5])), 3), "mean_D_parts_6_10": round(float(np.mean(parts[5:])), 3),
             "radial_cracks": c["radial_crack_count"], "radial_cracks_whole": c["radial_crack_count"] * mirror,
             "crack_length_whole_m": round(c["crack_length_total"] * mirror, 2),
-            "crushed_zone_radius_over_rb": round(c["crushed_zone_radius_over_rb"], 2),
+            **{k: round(v, 2) for k, v in zone_radii(c).items() if k.endswith("_over_rb")},
             "explosive_released_whole_J_per_m": round(s["energy"]["explosive_released"] * mirror),
             "ppv_K": round(s["vibration"]["attenuation"]["K"], 2), "ppv_beta": round(s["vibration"]["attenuation"]["beta"], 3),
         }

@@ -251,8 +251,8 @@ def case_row(case: Case, s: dict) -> dict:
     fd = s.get("fracture_degree") or {}
     row.update({f"D:{k}" if k not in ("D", "D_tensile", "D_shear", "D_crushed") else k: v for k, v in fd.items()})
     cracks = (s.get("cracks") or [{}])[0] if s.get("cracks") else {}
-    for k in ("crushed_zone_radius", "damaged_zone_radius", "radial_crack_count", "mean_radial_crack_length", "longest_radial_crack",
-              "crack_extent_r50", "crack_extent_r80", "crack_extent_r90", "connected_crack_length"):
+    for k in ("crushed_zone_radius", "dense_cracking_radius", "damaged_zone_radius", "radial_crack_count",
+              "mean_radial_crack_length", "longest_radial_crack", "crack_extent_r50", "crack_extent_r80", "crack_extent_r90", "connected_crack_length"):
         row[k] = cracks.get(k, math.nan)
     e = s.get("energy") or {}
     row["budget_error_relative"] = e.get("budget_error_relative", math.nan)

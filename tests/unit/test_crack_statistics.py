@@ -8,7 +8,13 @@ the pattern was drawn, not from the code.
 import numpy as np
 import pytest
 
-from blastfrac.analysis.cracks import circle_crossings, crack_statistics, detached_interface_mask, group_crossings
+from blastfrac.analysis.cracks import (
+    circle_crossings,
+    crack_statistics,
+    detached_interface_mask,
+    group_crossings,
+    radial_interfaces,
+)
 from blastfrac.model.builder import ModelBuilder
 from blastfrac.scenario import scenario_from_dict
 
@@ -90,11 +96,12 @@ def test_separate_cracks_counted_with_lengths(model):
     print(f"drawn 8 cracks: count {s['radial_crack_count']}, r_c/r_b {s['crushed_zone_radius_over_rb']:.2f}, "
           f"lengths {np.round(s['radial_crack_lengths'], 4)} vs {np.round(ENDS[::-1] - R_B, 4)}")
     assert s["crushed_zone_radius"] == R_B            # 8 cracks cannot crack half of the first ring
+    assert s["dense_cracking_radius"] == R_B
     assert s["detached_crack_sets"] == 0               # every ray starts at the wall
     assert s["connected_interfaces"] == s["cracked_interfaces"] == int(mode[0::2].sum())
     assert s["radial_crack_count"] == 8
     assert s["radial_crack_count_tensile"] == 8
-    expect = np.sort(ENDS - s["crushed_zone_radius"])[::-1]
+    expect = np.sort(ENDS - s["dense_cracking_radius"])[::-1]      # lengths start at r_k
     # a crack's last sampled circle lies within one ring width w of its tip, and the last interface the ray
     # crosses can reach one local element size h beyond the tip
     h = np.array(s["crossings"]["mesh_size"]).max()
@@ -102,13 +109,55 @@ def test_separate_cracks_counted_with_lengths(model):
 
 
 def test_network_joined_by_crushed_zone_still_counts_cracks(model):
-    """The cracks meet in a fully broken zone of 2.5 r_b: r_c is found and the 8 cracks are still 8 (the shortest
-    still reaches more than three elements beyond the zone)."""
+    """The cracks meet in a fully broken zone of 2.5 r_b: r_c (and r_k, every interface being cracked there) is found
+    and the 8 cracks are still 8 (the shortest still reaches more than three elements beyond the zone)."""
     mode = _draw(model, crushed=2.5 * R_B)
     s = crack_statistics(model, mode, np.zeros(2), R_B)
     w = s["ring_width"]
     assert abs(s["crushed_zone_radius"] - 2.5 * R_B) <= 1.5 * w
+    assert abs(s["dense_cracking_radius"] - 2.5 * R_B) <= 1.5 * w
     assert s["radial_crack_count"] == 8
+
+
+def test_radial_class_is_within_45_degrees_of_the_radius(model):
+    """radial_interfaces against the angle between each interface and the radius through its midpoint, from atan2."""
+    a, b = _interfaces(model)
+    mid = 0.5 * (a + b)
+    ang = np.abs(np.arctan2(b[:, 1] - a[:, 1], b[:, 0] - a[:, 0]) - np.arctan2(mid[:, 1], mid[:, 0])) % np.pi
+    ang = np.minimum(ang, np.pi - ang)                  # angle between the two lines, 0 … π/2
+    clear = np.abs(ang - np.pi / 4) > 1e-9
+    assert np.array_equal(radial_interfaces(a, b, np.zeros(2))[clear], (ang < np.pi / 4)[clear])
+    assert 0.35 < np.mean(ang < np.pi / 4) < 0.65      # a random mesh: about half in each class
+
+
+@pytest.mark.parametrize("R1", [2.0 * R_B, 3.0 * R_B])
+def test_crushed_zone_is_broken_in_every_direction(model, R1):
+    """Rock broken in every direction out to R1 and only along the radius from there to 5 r_b (a dense fan of radial
+    cracks): r_c is R1 within 1.5 ring widths; the dense-cracking radius r_k, which counts all interfaces together,
+    cannot tell the fan (about half of its interfaces cracked) from crushed rock."""
+    a, b = _interfaces(model)
+    r = np.linalg.norm(0.5 * (a + b), axis=1)
+    radial = radial_interfaces(a, b, np.zeros(2))
+    cracked = (r < R1) | (radial & (r < 5 * R_B))
+    s = crack_statistics(model, np.repeat(cracked.astype(np.int32), 2), np.zeros(2), R_B)
+    w = s["ring_width"]
+    print(f"\n  broken in every direction to {R1 / R_B:.0f} r_b, radial fan to 5 r_b: r_c/r_b "
+          f"{s['crushed_zone_radius_over_rb']:.2f}, r_k/r_b {s['dense_cracking_radius_over_rb']:.2f}")
+    assert abs(s["crushed_zone_radius"] - R1) <= 1.5 * w
+    assert s["dense_cracking_radius"] >= s["crushed_zone_radius"]
+
+
+def test_fan_of_radial_cracks_is_not_a_crushed_zone(model):
+    """Every radial interface within 4 r_b cracked and no circumferential one, the near-hole pattern of the blast
+    examples (docs/results.md, r_c): about half of each ring is cracked, yet nothing is crushed, r_c = r_b."""
+    a, b = _interfaces(model)
+    r = np.linalg.norm(0.5 * (a + b), axis=1)
+    radial = radial_interfaces(a, b, np.zeros(2))
+    cracked = radial & (r < 4 * R_B)
+    s = crack_statistics(model, np.repeat(cracked.astype(np.int32), 2), np.zeros(2), R_B)
+    near = r < 4 * R_B
+    assert 0.35 < cracked[near].mean() < 0.65            # the fraction the former rule thresholded at one half
+    assert s["crushed_zone_radius"] == R_B
 
 
 def test_shattered_ring_is_not_counted_as_cracks(model):

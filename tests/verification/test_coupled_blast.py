@@ -1,5 +1,5 @@
-"""A small coupled blast runs to completion: a crushed zone at the hole whose size lies in the empirical bracket,
-radial tensile cracks outside it, and an energy budget (explosive energy released = rock + gas + contact +
+"""A small coupled blast runs to completion: the rock about the hole cracked along every radius (and, a known gap, not
+crushed: the crushed zone lies below the empirical bracket), radial tensile cracks beyond, and an energy budget (explosive energy released = rock + gas + contact +
 losses) that closes within 5 %.
 
 Setup: a 3 mm hole filled with the paper's emulsion (Table 1) in a 12 cm square of its Table 2 rock with
@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 
+from blastfrac.analysis.cracks import radial_interfaces
 from blastfrac.explosives.library import get_explosive
 from blastfrac.scenario import scenario_from_dict
 from blastfrac.simulation import Simulation
@@ -67,6 +68,18 @@ def crushed_zone_bracket() -> tuple[float, float]:
     return esen, power
 
 
+def radial_cracked_fraction(sim, r0, r1):
+    """Fraction of the radial interfaces (within 45° of the radius; analysis.cracks.radial_interfaces) with midpoint
+    radius in [r0, r1) that have a broken spring."""
+    m = sim.model
+    pn = m.topology.pair_nodes
+    X = m.host["node_X"]
+    a, b = X[pn[0::2, 0]], X[pn[1::2, 0]]
+    r = np.linalg.norm(0.5 * (a + b), axis=1)
+    sel = radial_interfaces(a, b, np.zeros(2)) & (r >= r0) & (r < r1)
+    return float((sim.state.pair_mode.numpy().reshape(-1, 2) > 0).any(axis=1)[sel].mean())
+
+
 def tensile_orientation(sim, r_min):
     """Fraction of tensile-cracked interfaces beyond r_min whose edge lies within 30° of the radial direction."""
     m = sim.model
@@ -87,20 +100,24 @@ def test_small_coupled_blast(blast):
     e = s["energy"]
     c = s["cracks"][0]
     lo, hi = crushed_zone_bracket()
-    n_tens, frac_radial = tensile_orientation(sim, 2 * c["crushed_zone_radius"])
+    n_tens, frac_radial = tensile_orientation(sim, 2 * c["dense_cracking_radius"])
+    near_radial = radial_cracked_fraction(sim, R_B, 2 * R_B)
     print(f"blast: released {e['explosive_released']:.4g} J/m, rock KE {e['kinetic']:.4g}, fracture "
           f"{e['fracture']:.4g}, budget error {e['budget_error_relative']:.2%}; broken {s['broken_springs']}; "
           f"r_c/r_b {c['crushed_zone_radius_over_rb']:.2f} (bracket {lo:.2f}–{hi:.2f}); {c['radial_crack_count']} "
           f"radial cracks, longest {c['longest_radial_crack'] * 1e3:.1f} mm; {n_tens} tensile cracked interfaces "
-          f"beyond 2 r_c, {frac_radial:.2f} of them within 30° of radial")
+          f"beyond 2 r_k, {frac_radial:.2f} of them within 30° of radial; {near_radial:.2f} of the radial interfaces "
+          f"within 2 r_b cracked")
     # the charge burns completely: released energy = E0 × charge area
     assert abs(e["explosive_released"] / (E0_TABLE1 * np.pi * R_B**2) - 1) < 1e-9
     assert abs(e["budget_error_relative"]) < 0.05
-    # a crushed zone at the wall (its size against the empirical bracket: the next test)
-    assert c["crushed_zone_radius_over_rb"] > 1.0
+    # the hoop tension behind the outgoing front exceeds σ_t well beyond the hole (the stress-wave cracking radius of
+    # docs/validation.md §4 is ~12 r_b), so nearly every radial interface next to the wall cracks; whether the rock
+    # there is also crushed (broken in every direction) is the next test, a known gap
+    assert near_radial > 0.8
     # radial cracks outside it: several, reaching well beyond the crushed zone, tensile ones mostly radial
     assert c["radial_crack_count"] >= 6                  # 6–12 dominant radial cracks is the rule of thumb
-    assert c["longest_radial_crack"] > 3 * c["crushed_zone_radius"]
+    assert c["longest_radial_crack"] > 3 * c["dense_cracking_radius"]
     assert frac_radial > 0.45                            # a random orientation gives 1/3
     # outputs of a coupled run
     for f in ("summary.json", "resolved.toml", "monitors.csv", "energy.csv", "fracture_degree.csv", "rock.pvd",
@@ -112,12 +129,13 @@ def test_small_coupled_blast(blast):
     assert gp.max() > 1e9, "detonation-product pressure is read at the monitor"
 
 
-@pytest.mark.xfail(strict=True, reason="known gap (issue 11): the crushed zone is below the empirical bracket. With "
-                   "the 0.2 defaults r_c = 1.24 r_b here; with the rock mesh and the MPM cell halved 1.12 r_b with them "
-                   "and with pure FLIP alike, so pure FLIP's 2.43 r_b at this resolution was not converged "
-                   "(docs/explosive.md, 'Velocity transfer'). Mohr-Coulomb springs cannot crush in uniaxial strain; "
-                   "the opt-in cap rock.crushing_strength puts r_c where the peak stress passed it (docs/scenario.md, "
-                   "'Crushing'), which is not a prediction of the default law")
+@pytest.mark.xfail(strict=True, reason="known gap (issue 11): the crushed zone is below the empirical bracket. Crushed "
+                   "rock is broken in every direction (docs/results.md, r_c); here the radial interfaces next to the wall "
+                   "crack (84-100 %) and the circumferential ones do not (4-19 % in 0.6 mm rings), so r_c = 1.00 r_b, with "
+                   "the rock mesh and the MPM cell halved too (the former rule, all interfaces at one half, gave 1.24 and "
+                   "1.12 r_b: the share of radial interfaces in a ring). Mohr-Coulomb springs cannot crush in uniaxial "
+                   "strain; the opt-in cap rock.crushing_strength puts r_c where the peak stress passed it "
+                   "(docs/scenario.md, 'Crushing'), which is not a prediction of the default law")
 def test_crushed_zone_in_the_empirical_bracket(blast):
     _, s, _ = blast
     lo, hi = crushed_zone_bracket()

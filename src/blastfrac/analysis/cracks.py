@@ -1,4 +1,5 @@
-"""Crack statistics around a borehole: crushed-zone radius, radial crack count and lengths, detached cracks.
+"""Crack statistics around a borehole: crushed-zone and dense-cracking radii, radial crack count and lengths,
+detached cracks.
 
 Definitions (documented in docs/results.md). Positions are those of the reference configuration; an
 interface is *cracked* when at least one of its two springs has broken, and r is the distance of a point
@@ -11,21 +12,33 @@ from the hole centre.
   vertices of the hole's polygon). Where there is none (a charge without a borehole, whose r_b is half the
   charge's width), the boundary vertices within r_b + w.
 * **Ring width w**: the median length of the interfaces within 2 r_b of the centre (the mesh size at the wall).
+* **Orientation classes**: an interface is *radial* when it makes less than 45° with the radius through its
+  midpoint (a crack along it runs away from the hole), *circumferential* otherwise (a crack along it runs
+  round the hole).
 * **Crushed-zone radius r_c**: the outer radius of the run of consecutive rings [r_b + k·w, r_b + (k+1)·w),
-  starting at the wall, in which at least half of the interfaces are cracked (r_c = r_b when the first ring
-  is below one half). It is the radius within which most springs have broken. Its value counts all cracked
-  interfaces, connected or not.
+  starting at the wall, in which at least half of the radial interfaces *and* at least half of the
+  circumferential ones are cracked (r_c = r_b when the first ring fails; a ring without interfaces of a
+  class ends the run). Crushed rock is broken in every direction: a ring in which only the radial
+  interfaces are cracked is densely cracked by radial cracks, not crushed. (Until 2026-12-06 r_c thresholded
+  all interfaces together at one half. Around a blasthole nearly every radial interface cracks and few
+  circumferential ones do, so that fraction is the share of radial interfaces in the ring, about one half
+  in a random mesh: the rule read the mesh's orientation statistics, which is why two meshes of one size gave
+  values 17–51 % apart. That rule is kept as the dense-cracking radius r_k.)
+* **Dense-cracking radius r_k** (``dense_cracking_radius``): the same run of rings with at least half of all
+  interfaces cracked, whatever their orientation (r_k = r_b when the first ring is below one half): the zone
+  where radial cracks lie about one element apart, inside which single cracks are not counted (N(R) below
+  starts beyond it). It is noise-dominated (see r_c) and locates the start of the crack count only.
 * **Damaged-zone radius r_d**: the radius at which the cracked fraction of the interfaces, averaged over a
   ring one borehole radius wide (midpoint radii in [x − r_b/2, x + r_b/2)), has fallen to half its value in
   the first ring [r_b, 2 r_b). The ring centre x steps by ``DAMAGE_STEP``·r_b from 1.5 r_b and the crossing is
   interpolated linearly. It measures the extent of the dense damage about the hole, all cracked interfaces
-  counted, and unlike r_c it is well conditioned: r_c thresholds the fraction at one half in rings one mesh
+  counted, and unlike r_k it is well conditioned: r_k thresholds the fraction at one half in rings one mesh
   size wide, and the fraction sits near one half over the first two borehole radii, so two meshes of the same
-  size gave r_c 17–51 % apart, r_d 1–9 % (examples/confined_blast/mesh_study.md, "The crushed zone").
+  size gave r_k 17–51 % apart, r_d 1–9 % (examples/confined_blast/mesh_study.md, "The crushed zone").
   r_d = r_b when the first ring has no crack; when the fraction never falls to half within the mesh, r_d is
   the centre of the last ring that holds interfaces, a lower bound (``damaged_zone_radius_censored``).
-* **Connected network** (of this hole): the crack sets that have a vertex on the wall, or, when r_c > r_b,
-  a vertex at r ≤ r_c (the crushed zone touches the wall by construction). All other crack sets are
+* **Connected network** (of this hole): the crack sets that have a vertex on the wall, or, when r_k > r_b,
+  a vertex at r ≤ r_k (the densely cracked zone touches the wall by construction). All other crack sets are
   **detached**: they are reported apart (number, total length, number of those of more than ``MIN_EXTENT``
   interfaces) and count in no N(R). A crack set joined only to *another* borehole is detached for this one.
 * **Crack crossings of a circle** of radius R about the centre: the points where cracked interfaces of the
@@ -35,7 +48,7 @@ from the hole centre.
   crosses). A group whose arc is at most ``NARROW_ARC``·h long is one *crack crossing*; wider groups are
   shattered or tangential (spalling) zones, not single cracks. The shattered arc (``shattered_arc``) is
   measured on all cracked interfaces, connected or not, since a detached fragmented zone is damage too.
-* **N(R)**: the number of crack crossings of the circle R, sampled every w from r_c + 2w outward, for the
+* **N(R)**: the number of crack crossings of the circle R, sampled every w from r_k + 2w outward, for the
   connected network and for its tensile interfaces (an interface counts as tensile when a spring broke in
   tension). Crossings of neighbouring circles are linked into radial chains, and only crossings on chains at
   least ``MIN_EXTENT``·h long count (a crack is at least three elements long; this drops the ragged fringe
@@ -46,11 +59,11 @@ from the hole centre.
   Unlike a count of connected crack sets, this does not collapse a network whose cracks meet in the
   crushed zone into one crack.
 * **Radial crack lengths**: the k-th longest crack reaches R_k = max{R : N(R) ≥ k}; its length is
-  R_k − r_c (measured from the edge of the crushed zone), for k = 1 … N_rad.
+  R_k − r_k (measured from the edge of the densely cracked zone), for k = 1 … N_rad.
 
 Pre-existing joints (geometry.joints, docs/joints.md) are not blast cracks: their interfaces are never
-*cracked* here, whether open from t = 0 or broken during the run, and they count in no ring of the
-crushed-zone radius (:func:`blast_cracked`).
+*cracked* here, whether open from t = 0 or broken during the run, and they count in no ring of r_c or r_k
+(:func:`blast_cracked`).
 """
 
 from __future__ import annotations
@@ -189,12 +202,13 @@ def persistent_counts(radii, angles: list[list[float]], sizes: list[float]) -> l
     return counts
 
 
-def lengths_from_profile(radii: np.ndarray, counts: np.ndarray, r_c: float) -> list[float]:
-    """Crack lengths R_k − r_c [m], longest first, with R_k = max{R : N(R) ≥ k}, k = 1 … max N."""
+def lengths_from_profile(radii: np.ndarray, counts: np.ndarray, r_k: float) -> list[float]:
+    """Crack lengths R_k − r_k [m], longest first, with R_k = max{R : N(R) ≥ k}, k = 1 … max N (r_k: the
+    dense-cracking radius, where the count starts)."""
     radii, counts = np.asarray(radii, float), np.asarray(counts, int)
     out = []
     for k in range(1, int(counts.max(initial=0)) + 1):
-        out.append(float(radii[counts >= k].max() - r_c))
+        out.append(float(radii[counts >= k].max() - r_k))
     return out
 
 
@@ -251,16 +265,42 @@ def blast_cracked(model, mode: np.ndarray) -> np.ndarray:
     return cracked if joint is None else cracked & ~joint
 
 
-def crushed_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float, w: float) -> float:
-    """Crushed-zone radius r_c [m]: outer radius of the rings of width w [m] from the wall, each ≥ half cracked.
+def radial_interfaces(a: np.ndarray, b: np.ndarray, center: np.ndarray) -> np.ndarray:
+    """Interfaces a→b [m] (rows) within 45° of the radius from ``center`` [m] through their midpoint, mask [Q]: the
+    *radial* orientation class; the others are *circumferential* (see the module doc)."""
+    mid = 0.5 * (a + b) - center
+    t = b - a
+    # |cos| of the angle to the radius > 1/√2, without roots: 2 (t·m)² > |t|²|m|²
+    return 2.0 * np.einsum("ij,ij->i", t, mid) ** 2 > np.einsum("ij,ij->i", t, t) * np.einsum("ij,ij->i", mid, mid)
+
+
+def dense_cracking_radius(r: np.ndarray, cracked: np.ndarray, r_b: float, w: float) -> float:
+    """Dense-cracking radius r_k [m]: outer radius of the rings of width w [m] from the wall, each ≥ half cracked.
 
     ``r``: midpoint radius of each interface [m]; ``cracked``: mask over the interfaces.
+    """
+    r_k, k = r_b, 0
+    while True:
+        ring = (r >= r_b + k * w) & (r < r_b + (k + 1) * w)
+        if ring.sum() == 0 or cracked[ring].mean() < 0.5:
+            return r_k
+        k += 1
+        r_k = r_b + k * w
+
+
+def crushed_zone_radius(r: np.ndarray, cracked: np.ndarray, radial: np.ndarray, r_b: float, w: float) -> float:
+    """Crushed-zone radius r_c [m]: outer radius of the rings of width w [m] from the wall in each of which at least
+    half of the radial interfaces and at least half of the circumferential ones are cracked (module doc).
+
+    ``r``: midpoint radius of each interface [m]; ``cracked``, ``radial`` (:func:`radial_interfaces`): masks over the
+    interfaces.
     """
     r_c, k = r_b, 0
     while True:
         ring = (r >= r_b + k * w) & (r < r_b + (k + 1) * w)
-        if ring.sum() == 0 or cracked[ring].mean() < 0.5:
-            return r_c
+        for cls in (ring & radial, ring & ~radial):
+            if cls.sum() == 0 or cracked[cls].mean() < 0.5:
+                return r_c
         k += 1
         r_c = r_b + k * w
 
@@ -297,11 +337,11 @@ def damaged_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float) -> tuple
 
 
 def connected_network(model, cracked: np.ndarray, center: np.ndarray, r_b: float) -> dict:
-    """The crack network of one hole: ring width w, r_c [m], and per interface its set label and connected mask.
+    """The crack network of one hole: ring width w, r_c and r_k [m], and per interface its set label and connected mask.
 
-    Returns ``w``, ``r_c``, ``label`` (crack-set label of each interface, meaningful where cracked),
-    ``connected`` (cracked and in a set with a vertex on the wall, or at r ≤ r_c when r_c > r_b), ``wall``
-    (the wall's mesh vertex ids) and ``length`` (interface lengths [m]).
+    Returns ``w``, ``r_c`` (crushed zone), ``r_k`` (dense cracking), ``label`` (crack-set label of each interface,
+    meaningful where cracked), ``connected`` (cracked and in a set with a vertex on the wall, or at r ≤ r_k when
+    r_k > r_b), ``wall`` (the wall's mesh vertex ids) and ``length`` (interface lengths [m]).
     """
     X = model.host["node_X"]
     pn = model.topology.pair_nodes
@@ -310,16 +350,18 @@ def connected_network(model, cracked: np.ndarray, center: np.ndarray, r_b: float
     r = np.linalg.norm(0.5 * (a + b) - center, axis=1)
     w = ring_width(L, r, r_b)
     joint = joint_interface_mask(model)
-    r_c = crushed_zone_radius(r, cracked, r_b, w) if joint is None else crushed_zone_radius(r[~joint], cracked[~joint], r_b, w)
+    keep = np.ones(len(r), bool) if joint is None else ~joint
+    r_k = dense_cracking_radius(r[keep], cracked[keep], r_b, w)
+    r_c = crushed_zone_radius(r[keep], cracked[keep], radial_interfaces(a, b, center)[keep], r_b, w)
     ends = interface_vertices(model)
     label = vertex_components(ends, cracked, len(model.mesh.vertices))[ends[:, 0]]
     wall = wall_vertices(model, center, r_b, w)
     seed = cracked & np.isin(ends, wall).any(axis=1)
-    if r_c > r_b:
+    if r_k > r_b:
         r_end = np.minimum(np.linalg.norm(a - center, axis=1), np.linalg.norm(b - center, axis=1))
-        seed |= cracked & (r_end <= r_c)
+        seed |= cracked & (r_end <= r_k)
     connected = cracked & np.isin(label, label[seed])
-    return {"w": w, "r_c": r_c, "label": label, "connected": connected, "wall": wall, "length": L}
+    return {"w": w, "r_c": r_c, "r_k": r_k, "label": label, "connected": connected, "wall": wall, "length": L}
 
 
 def detached_sets(label: np.ndarray, length: np.ndarray, detached: np.ndarray) -> dict:
@@ -350,7 +392,7 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
     """Statistics of the cracks around the hole at ``center`` [m] of radius ``r_b`` [m] (SI units).
 
     N(R), the radial crack count and lengths count only the crack network connected to this hole's wall
-    (or to its crushed zone); the other crack sets are reported as detached (``detached_*``). With several
+    (or to its densely cracked zone, r ≤ r_k); the other crack sets are reported as detached (``detached_*``). With several
     boreholes this is called once per hole, and a crack set joined only to another hole is detached here.
     """
     X = model.host["node_X"]
@@ -360,27 +402,29 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
     cracked = blast_cracked(model, mode)
     tensile = (pair_mode == 1).any(axis=1) & cracked
     net = connected_network(model, cracked, center, r_b)
-    w, r_c, connected = net["w"], net["r_c"], net["connected"]
+    w, r_c, r_k, connected = net["w"], net["r_c"], net["r_k"], net["connected"]
     mid_r = np.linalg.norm(0.5 * (a + b) - center, axis=1)
     joint = joint_interface_mask(model)
     r_d, r_d_censored = damaged_zone_radius(mid_r, cracked, r_b) if joint is None else \
         damaged_zone_radius(mid_r[~joint], cracked[~joint], r_b)
-    # crack crossings of circles outside the crushed zone
+    # crack crossings of circles outside the densely cracked zone
     r_max = float(np.linalg.norm(np.concatenate([a, b]) - center, axis=1).max())
-    radii = np.arange(r_c + 2 * w, r_max, w)
+    radii = np.arange(r_k + 2 * w, r_max, w)
     if len(radii) > 400:                     # keep the profile short on big meshes
         radii = np.linspace(radii[0], radii[-1], 400)
     prof = crossing_profile(a, b, cracked, tensile, center, radii, connected)
     counts = np.asarray(prof["count"], int)
-    lengths = lengths_from_profile(radii, counts, r_c)
+    lengths = lengths_from_profile(radii, counts, r_k)
     n_rad = int(counts.max(initial=0))
-    r_at = float(radii[int(np.argmax(counts))]) if len(radii) else r_c
+    r_at = float(radii[int(np.argmax(counts))]) if len(radii) else r_k
     return {
         "center": [float(center[0]), float(center[1])],
         "borehole_radius": r_b,
         "ring_width": w,
         "crushed_zone_radius": r_c,
         "crushed_zone_radius_over_rb": r_c / r_b,
+        "dense_cracking_radius": r_k,
+        "dense_cracking_radius_over_rb": r_k / r_b,
         "damaged_zone_radius": r_d,
         "damaged_zone_radius_over_rb": r_d / r_b,
         "damaged_zone_radius_censored": r_d_censored,
@@ -420,3 +464,16 @@ def crack_extent(mid: np.ndarray, length: np.ndarray, cracked: np.ndarray, cente
     for f in EXTENT_FRACTIONS:
         out[f"crack_extent_r{int(round(100 * f))}"] = float(r[order][np.searchsorted(cum, f * (1 - 1e-12))]) if len(L) else 0.0
     return out
+
+
+def zone_radii(c: dict) -> dict:
+    """r_c and r_k [m] (and over r_b) of a summary.json → cracks entry, also of one written before 2026-12-06: its
+    ``crushed_zone_radius`` was the rule now called the dense-cracking radius r_k, and r_c was not computed (NaN)."""
+    if "dense_cracking_radius" in c:
+        keys = ("crushed_zone_radius", "crushed_zone_radius_over_rb", "dense_cracking_radius",
+                "dense_cracking_radius_over_rb")
+        return {k: c[k] for k in keys}
+    nan = float("nan")
+    return {"crushed_zone_radius": nan, "crushed_zone_radius_over_rb": nan,
+            "dense_cracking_radius": c["crushed_zone_radius"],
+            "dense_cracking_radius_over_rb": c["crushed_zone_radius_over_rb"]}

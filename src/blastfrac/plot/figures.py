@@ -238,7 +238,7 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
     """Cracks connected to each hole crossing circles about it, N(R), and the shattered fraction of each circle.
 
     ``stats``: the entries of summary.json → cracks (analysis.cracks.crack_statistics), one per hole. N(R)
-    counts only the crack network joined to the hole's wall or crushed zone; the detached crack sets are
+    counts only the crack network joined to the hole's wall or densely cracked zone; the detached crack sets are
     drawn as a light line (``count_all``, all cracked interfaces) and summed up in the legend.
     """
     plt = _plt()
@@ -255,7 +255,9 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
                     f"{_detached_note(s)}")
         frac = np.asarray(p["shattered_arc"]) / (2 * np.pi * np.asarray(p["radius"]))
         ax2.fill_between(R, 0, np.minimum(frac, 1.0), color="0.6", alpha=0.3, lw=0)
-        ax.axvline(s["crushed_zone_radius_over_rb"], color=SHEAR_COLOR, lw=0.8, ls=":")
+        ax.axvline(s["crushed_zone_radius_over_rb"], color=SHEAR_COLOR, lw=1.2, ls=":")
+        if "dense_cracking_radius_over_rb" in s:
+            ax.axvline(s["dense_cracking_radius_over_rb"], color="0.4", lw=0.8, ls="--")
         if "damaged_zone_radius_over_rb" in s:
             ax.axvline(s["damaged_zone_radius_over_rb"], color=SHEAR_COLOR, lw=0.8, ls="-.")
     ax.set_xlabel("radius R / r_b [-]")
@@ -265,7 +267,7 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
-    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius r_c; dash-dot: damaged-zone radius r_d)", 90), fontsize=9)
+    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius r_c; grey dashed: dense-cracking radius r_k, where the count starts; dash-dot: damaged-zone radius r_d)", 90), fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
