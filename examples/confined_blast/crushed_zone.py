@@ -74,7 +74,7 @@ def figure(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.5), dpi=110)
+    fig, ax = plt.subplots(figsize=(10.5, 4.5), dpi=110)
     for i, z in enumerate(rows):
         col = f"C{i}"
         mid = 0.5 * (z["edges"][:-1] + z["edges"][1:]) / R_B
@@ -86,7 +86,7 @@ def figure(rows: list[dict], path: Path) -> None:
     ax.set_xlabel("r / r_b")
     ax.set_ylabel(f"cracked fraction of the class, {RING * 1e3:.0f} mm rings")
     ax.set_ylim(0, 1.02)
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.set_title("Crushed means broken in every direction: the radial interfaces crack, the circumferential ones\n"
                  "mostly do not (dotted: crushed-zone radius r_c)", fontsize=9)
     fig.tight_layout()
