@@ -1,6 +1,6 @@
 """A small coupled blast runs to completion: the rock about the hole cracked along every radius (and, a known gap, not
-crushed: the crushed zone lies below the empirical bracket), radial tensile cracks beyond, and an energy budget (explosive energy released = rock + gas + contact +
-losses) that closes within 5 %.
+crushed: the crushed zone lies below the empirical bracket), radial tensile cracks beyond, and an energy budget
+(explosive energy released = rock + gas + contact + losses) that closes within 5 %.
 
 Setup: a 3 mm hole filled with the paper's emulsion (Table 1) in a 12 cm square of its Table 2 rock with
 non-reflecting sides, 20 µs; the rock law of the shipped blast examples (shock viscosity, spring dashpots,
@@ -129,13 +129,13 @@ def test_small_coupled_blast(blast):
     assert gp.max() > 1e9, "detonation-product pressure is read at the monitor"
 
 
-@pytest.mark.xfail(strict=True, reason="known gap (issue 11): the crushed zone is below the empirical bracket. Crushed "
-                   "rock is broken in every direction (docs/results.md, r_c); here the radial interfaces next to the wall "
-                   "crack (84-100 %) and the circumferential ones do not (4-19 % in 0.6 mm rings), so r_c = 1.00 r_b, with "
-                   "the rock mesh and the MPM cell halved too (the former rule, all interfaces at one half, gave 1.24 and "
-                   "1.12 r_b: the share of radial interfaces in a ring). Mohr-Coulomb springs cannot crush in uniaxial "
-                   "strain; the opt-in cap rock.crushing_strength puts r_c where the peak stress passed it "
-                   "(docs/scenario.md, 'Crushing'), which is not a prediction of the default law")
+@pytest.mark.xfail(strict=True, reason="known gap (issue 11): the crushed zone is below the empirical bracket. "
+                   "Crushed rock is broken in every direction (docs/results.md, r_c); here the radial interfaces next "
+                   "to the wall crack (84-100 %) and the circumferential ones do not (4-19 % in 0.6 mm rings), so "
+                   "r_c = 1.00 r_b, with the rock mesh and the MPM cell halved too (the former rule, all interfaces at "
+                   "one half, gave 1.24 and 1.12 r_b: the share of radial interfaces in a ring). Mohr-Coulomb springs "
+                   "cannot crush in uniaxial strain; the opt-in cap rock.crushing_strength puts r_c where the peak "
+                   "stress passed it (docs/scenario.md, 'Crushing'), which is not a prediction of the default law")
 def test_crushed_zone_in_the_empirical_bracket(blast):
     _, s, _ = blast
     lo, hi = crushed_zone_bracket()

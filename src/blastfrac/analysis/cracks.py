@@ -337,7 +337,7 @@ def damaged_zone_radius(r: np.ndarray, cracked: np.ndarray, r_b: float) -> tuple
 
 
 def connected_network(model, cracked: np.ndarray, center: np.ndarray, r_b: float) -> dict:
-    """The crack network of one hole: ring width w, r_c and r_k [m], and per interface its set label and connected mask.
+    """The crack network of one hole: ring width w, r_c and r_k [m], per interface its set label and connected mask.
 
     Returns ``w``, ``r_c`` (crushed zone), ``r_k`` (dense cracking), ``label`` (crack-set label of each interface,
     meaningful where cracked), ``connected`` (cracked and in a set with a vertex on the wall, or at r ≤ r_k when
@@ -392,8 +392,9 @@ def crack_statistics(model, mode: np.ndarray, center: np.ndarray, r_b: float) ->
     """Statistics of the cracks around the hole at ``center`` [m] of radius ``r_b`` [m] (SI units).
 
     N(R), the radial crack count and lengths count only the crack network connected to this hole's wall
-    (or to its densely cracked zone, r ≤ r_k); the other crack sets are reported as detached (``detached_*``). With several
-    boreholes this is called once per hole, and a crack set joined only to another hole is detached here.
+    (or to its densely cracked zone, r ≤ r_k); the other crack sets are reported as detached (``detached_*``).
+    With several boreholes this is called once per hole, and a crack set joined only to another hole is detached
+    here.
     """
     X = model.host["node_X"]
     pn = model.topology.pair_nodes
