@@ -727,7 +727,8 @@ class Simulation:
         cracks = self.crack_statistics() if cracks is None else cracks
         if cracks:
             figures.crack_profile(self.out_dir / "crack_profile.png", cracks,
-                                  title=f"{title}: cracks crossing circles about the hole (dotted: r_c, dash-dot: r_d)")
+                                  title=f"{title}: cracks crossing circles about the hole (dotted: r_c; grey dashed: "
+                                        "r_k; dash-dot: r_d)")
         t = np.array([r[0] for r in frac.rows])
         figures.fracture_degree_zones(self.out_dir / "fracture_degree.png", t,
                                       {k: frac.column(k) for k in frac.columns[1:]}, title=f"{title}: fracture degree")

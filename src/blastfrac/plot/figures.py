@@ -267,7 +267,9 @@ def crack_profile(path: Path, stats: list[dict], title: str = "") -> None:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
-    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius r_c; grey dashed: dense-cracking radius r_k, where the count starts; dash-dot: damaged-zone radius r_d)", 90), fontsize=9)
+    ax.set_title(textwrap.fill(title or "Radial cracks connected to the hole (dotted: crushed-zone radius r_c; grey "
+                               "dashed: dense-cracking radius r_k, where the count starts; dash-dot: damaged-zone "
+                               "radius r_d)", 90), fontsize=9)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
