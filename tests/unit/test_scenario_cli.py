@@ -76,6 +76,10 @@ def test_check_prints_counts(capsys):
     out = capsys.readouterr().out
     for word in ("elements", "springs", "stable dt", "steps to end time", "memory"):
         assert word in out
+    # penalty springs β·E'/h̄ with β = 20 are far stiffer than the blocks: they, not the CST, set the rock's step
+    import re
+    rock, blocks = re.search(r"stable dt rock \(Gershgorin\)\s+(\S+) s \(the blocks alone would allow (\S+) s", out).groups()
+    assert float(blocks) > 3 * float(rock)
     assert "heterogeneity" not in out                      # homogeneous rock: no row
     assert main(["check", str(DEMO), "--set", "rock.heterogeneity.weibull_modulus=5",
                  "--set", "rock.heterogeneity.reference_length=0.002"]) == 0

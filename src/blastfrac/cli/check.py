@@ -17,6 +17,21 @@ STEPS_WARNING = 10_000_000    # check warns above this many steps to the end tim
 CHARGE_CELLS_ACROSS_MIN = 20
 
 
+
+def _blocks_alone(m) -> str:
+    """What the blocks alone would allow (the Gershgorin bound of their CST rows, no springs) beside the rock's step,
+    and whether the springs set it: with the stiff penalty springs they do, by a factor of ~6 on the blasts' meshes
+    (docs/rock_fronts.md, "Why the spring penalty stays at β = 20")."""
+    import numpy as np
+
+    from ..model.builder import element_row_sums
+
+    row = element_row_sums(m.host["node_X"], m.lam, m.mu)
+    dt = 2.0 / math.sqrt(float(np.max(row / m.host["node_mass_dt"][:, None])))
+    if dt > 1.2 * m.stable_dt:
+        return f" (the blocks alone would allow {dt:.4e} s: the springs set the step, docs/rock_fronts.md)"
+    return f" (the blocks alone: {dt:.4e} s)"
+
 def add_parser(sub) -> None:
     p = sub.add_parser("check", help="validate a scenario and print what would run")
     add_scenario_args(p)
@@ -101,7 +116,7 @@ def run(args) -> int:
          + (" (compensated for the spring compliance)" if el.compensated else " (as given)")),
         ("assembly E, nu, c_p, c_s", f"{el.assembly_E / 1e9:.4g} GPa, {el.assembly_nu:.4g}, {cp:.1f} m/s, {cs:.1f} m/s"
          + f" (c_p {cp / cp0 - 1:+.2%} against the input)"),
-        ("stable dt rock (Gershgorin)", f"{m.stable_dt:.4e} s"),
+        ("stable dt rock (Gershgorin)", f"{m.stable_dt:.4e} s" + _blocks_alone(m)),
         *dt_rows,
         ("dt used", f"{dt:.4e} s"),
         ("end time", f"{sc.simulation.end_time:.4e} s"),
