@@ -328,3 +328,17 @@ def test_damaged_zone_radius_of_rock_cracked_throughout_is_censored(model):
     s = crack_statistics(model, np.repeat(cracked.astype(np.int32), 2), np.zeros(2), R_B)
     assert s["damaged_zone_radius_censored"] is True
     assert 0.12 - R_B <= s["damaged_zone_radius"] <= 0.12
+
+
+def test_zone_radii_reads_summaries_from_before_the_crushed_zone_rule_changed(model):
+    """A summary written before 2026-12-06 reported the rule now called r_k as crushed_zone_radius; zone_radii gives
+    it as r_k and r_c as unknown (NaN), and a new summary's radii as they are."""
+    from blastfrac.analysis.cracks import zone_radii
+
+    old = {"crushed_zone_radius": 0.00885, "crushed_zone_radius_over_rb": 1.77}
+    z = zone_radii(old)
+    assert z["dense_cracking_radius"] == 0.00885 and z["dense_cracking_radius_over_rb"] == 1.77
+    assert np.isnan(z["crushed_zone_radius"]) and np.isnan(z["crushed_zone_radius_over_rb"])
+    s = crack_statistics(model, _draw(model, crushed=2.5 * R_B), np.zeros(2), R_B)
+    assert zone_radii(s) == {k: s[k] for k in ("crushed_zone_radius", "crushed_zone_radius_over_rb",
+                                               "dense_cracking_radius", "dense_cracking_radius_over_rb")}
