@@ -47,13 +47,15 @@ def main() -> None:
     a = ap.parse_args()
     lo, hi = crushed_zone_bracket()
     rows = [f"Bracket r_c/r_b {lo:.2f} (Esen) – {hi:.2f} (power law to the UCS); UCS {UCS / 1e6:.1f} MPa.", "",
-            "| σ_cr / UCS | mesh | r_c / r_b | radial cracks | longest [mm] | tensile / shear / crushed springs |",
-            "|---:|---:|---:|---:|---:|---|"]
+            "| σ_cr / UCS | mesh | r_c / r_b (broken in every direction) | r_k / r_b (the former r_c) | radial cracks | "
+            "longest [mm] | tensile / shear / crushed springs |",
+            "|---:|---:|---:|---:|---:|---:|---|"]
     for f in a.factors:
         for sc in a.scales:
             r = blast(f, sc, a.out / f"cap{f:g}_scale{sc:g}")
             b = r["broken"]
-            rows.append(f"| {'none' if f == 0 else f'{f:g}'} | h/{sc:g} | {r['rc']:.2f} | {r['radial']} | "
+            rows.append(f"| {'none' if f == 0 else f'{f:g}'} | h/{sc:g} | {r['rc_crushed']:.2f} | {r['rc']:.2f} | "
+                        f"{r['radial']} | "
                         f"{r['longest_mm']:.1f} | {b['tensile']} / {b['shear']} / {b['crushed']} |")
             print(rows[-1], flush=True)
     (HERE / "crushing_study.md").write_text("\n".join(rows) + "\n")
