@@ -68,27 +68,27 @@ def crushed_zone_bracket() -> tuple[float, float]:
     return esen, power
 
 
-def radial_cracked_fraction(sim, r0, r1):
-    """Fraction of the radial interfaces (within 45° of the radius; analysis.cracks.radial_interfaces) with midpoint
-    radius in [r0, r1) that have a broken spring."""
+def _interfaces(sim):
+    """Both ends a, b [m] of each interface, its midpoint radius r [m] and the modes of its two springs [Q, 2]."""
     m = sim.model
     pn = m.topology.pair_nodes
     X = m.host["node_X"]
     a, b = X[pn[0::2, 0]], X[pn[1::2, 0]]
-    r = np.linalg.norm(0.5 * (a + b), axis=1)
+    return a, b, np.linalg.norm(0.5 * (a + b), axis=1), sim.state.pair_mode.numpy().reshape(-1, 2)
+
+
+def radial_cracked_fraction(sim, r0, r1):
+    """Fraction of the radial interfaces (within 45° of the radius; analysis.cracks.radial_interfaces) with midpoint
+    radius in [r0, r1) that have a broken spring."""
+    a, b, r, mode = _interfaces(sim)
     sel = radial_interfaces(a, b, np.zeros(2)) & (r >= r0) & (r < r1)
-    return float((sim.state.pair_mode.numpy().reshape(-1, 2) > 0).any(axis=1)[sel].mean())
+    return float((mode > 0).any(axis=1)[sel].mean())
 
 
 def tensile_orientation(sim, r_min):
     """Fraction of tensile-cracked interfaces beyond r_min whose edge lies within 30° of the radial direction."""
-    m = sim.model
-    pn = m.topology.pair_nodes
-    X = m.host["node_X"]
-    mode = sim.state.pair_mode.numpy().reshape(-1, 2)
-    a, b = X[pn[0::2, 0]], X[pn[1::2, 0]]
+    a, b, r, mode = _interfaces(sim)
     mid = 0.5 * (a + b)
-    r = np.linalg.norm(mid, axis=1)
     t = (b - a) / np.linalg.norm(b - a, axis=1)[:, None]
     radial_cos = np.abs(np.einsum("ij,ij->i", t, mid / r[:, None]))
     tens = (mode == 1).any(axis=1) & (r > r_min)

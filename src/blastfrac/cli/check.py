@@ -17,10 +17,9 @@ STEPS_WARNING = 10_000_000    # check warns above this many steps to the end tim
 CHARGE_CELLS_ACROSS_MIN = 20
 
 
-
 def _blocks_alone(m) -> str:
     """What the blocks alone would allow (the Gershgorin bound of their CST rows, no springs) beside the rock's step,
-    and whether the springs set it: with the stiff penalty springs they do, by a factor of ~6 on the blasts' meshes
+    and whether the springs set it: with the stiff penalty springs they do, by a factor of ~7 on the demo's mesh
     (docs/rock_fronts.md, "Why the spring penalty stays at β = 20")."""
     import numpy as np
 
@@ -31,6 +30,7 @@ def _blocks_alone(m) -> str:
     if dt > 1.2 * m.stable_dt:
         return f" (the blocks alone would allow {dt:.4e} s: the springs set the step, docs/rock_fronts.md)"
     return f" (the blocks alone: {dt:.4e} s)"
+
 
 def add_parser(sub) -> None:
     p = sub.add_parser("check", help="validate a scenario and print what would run")
