@@ -121,9 +121,9 @@ def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
         top = top[np.abs(np.arctan2(X[top, 0], X[top, 1])) <= half + 1e-9]
         bottom = bottom[np.abs(np.arctan2(X[bottom, 0], -X[bottom, 1])) <= half + 1e-9]
     platens = Platens(m, top, bottom, (spec.height / 2, -spec.height / 2), radius, kp, s.bonded)
-    # the builder's Gershgorin step of a breakable model allows for one contact of spring
-    # stiffness per node (METHOD §1.7), which covers the platen penalty; an unbreakable model
-    # has no such allowance, so take the same margin (1/√2) here
+    # the builder's Gershgorin step of a breakable model allows for one block contact per node,
+    # 2·k_c·t_n (METHOD §1.7; about four median spring stiffnesses on a uniform specimen mesh), which
+    # covers the platen penalty; an unbreakable model has no such allowance, so take a margin of 1/√2
     dt = s.dt_safety * m.stable_dt * (1.0 if m.breakable else 1.0 / math.sqrt(2.0))
     cp = spec.scenario.rock.p_wave_speed
     t_ramp = s.ramp_transits * spec.height / cp

@@ -121,11 +121,13 @@ contact (~0.3 ms) and the corner test of ~6,500 held ones in the listing pass (~
 ×2.9 with 17 % of the springs broken (×1.4 with ``held_faces`` off, at the price of 0.3·h overlaps in the
 crushed zone).
 
-**Stable step** (METHOD §1.7). ModelBuilder doubles the spring row sums of a breakable model, an allowance
-of 2·K_c per contact with K_c = kn·A_node of a node whose edges are all exposed (the springs of those edges
-had the same total stiffness). ``BlockContact.stable_dt()`` is the Gershgorin bound with every spring intact
-*and* every node in one such contact; model.stable_dt is below it (checked in the tests), and the cap keeps
-single contacts stable at nodes with little spring allowance (mesh-boundary corners).
+**Stable step** (METHOD §1.7). ModelBuilder adds 2·K_c to each node's row sums of a breakable model, one
+contact of the stiffness this module applies: K_c = kn_area·A_node with A_node half of each of the node's two
+element edges (``contact_stiffness_per_area``, ``node_tributary_length``; until 2026-12-06 it doubled the spring
+rows, which on a graded mesh allowed for a contact several times stiffer than this one where the step is set).
+``BlockContact.stable_dt()`` is the Gershgorin bound with every spring intact *and* every node in one such
+contact; model.stable_dt is below it (checked in the tests), and the cap keeps contacts beyond that allowance
+stable (a node that is the end of other nodes' contact edges, light nodes at slivers).
 """
 
 from __future__ import annotations
@@ -136,6 +138,7 @@ import numpy as np
 import warp as wp
 
 from .._warp import Launcher
+from ..model.builder import contact_stiffness_per_area, element_row_sums, node_tributary_length
 from .contact_data import (
     ContactCache,
     ContactHash,
@@ -177,7 +180,7 @@ class BlockContact:
         lengths = model.mesh.edge_lengths()                       # [E, 3], slot 3e+k has length [e, k]
         self.l_max = float(lengths.max())
         self.h_min = float(np.min(2.0 * h["elem_area0"] / lengths.max(axis=1)))
-        self.kn_area = float(np.mean(h["pair_kn_area"])) if len(h["pair_kn_area"]) else 0.0
+        self.kn_area = contact_stiffness_per_area(h)
         self.mu_f = model.tan_phi_r
         # Hash points: every edge sampled at spacing ≤ ℓ_ref (its midpoint if shorter), so a query of radius
         # ½ℓ_ref·1.25 + h_min around a node finds every edge within h_min/2 of it with h_min/2 to spare, however
@@ -584,8 +587,6 @@ class BlockContact:
     def stable_dt(self) -> float:
         """Gershgorin bound 2/ω_max [s] with every node in one block contact of its largest Kc (METHOD §1.7):
         CST rows + 2·max(Kn, Ks) per intact spring + 2·Kc, Kc = kn·(half of each of its element's edges at it)."""
-        from ..model.builder import element_row_sums
-
         m, h = self.model, self.model.host
         X = h["node_X"]
         row = element_row_sums(X, m.lam, m.mu).max(axis=1)
@@ -593,8 +594,5 @@ class BlockContact:
         k = 2.0 * np.maximum(h["pair_kn"], h["pair_ks"])
         np.add.at(row, pn[:, 0], k)
         np.add.at(row, pn[:, 1], k)
-        lengths = m.mesh.edge_lengths().ravel()
-        nodes = np.arange(m.node_count)
-        trib = 0.5 * (lengths[nodes] + lengths[3 * (nodes // 3) + (nodes % 3 + 2) % 3])
-        row += 2.0 * self.kn_area * trib
+        row += 2.0 * self.kn_area * node_tributary_length(X)
         return 2.0 / math.sqrt(float(np.max(row / h["node_mass_dt"])))

@@ -19,7 +19,7 @@ CHARGE_CELLS_ACROSS_MIN = 20
 
 def _blocks_alone(m) -> str:
     """What the blocks alone would allow (the Gershgorin bound of their CST rows, no springs) beside the rock's step,
-    and whether the springs set it: with the stiff penalty springs they do, by a factor of ~7 on the demo's mesh
+    and whether the springs set it: with the stiff penalty springs they do, by a factor of ~6 on the demo's mesh
     (docs/rock_fronts.md, "Why the spring penalty stays at β = 20")."""
     import numpy as np
 

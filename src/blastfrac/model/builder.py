@@ -218,7 +218,8 @@ class ModelBuilder:
         h["ledge_f0"] = np.array(lf).reshape(-1, 2)
 
     def _gershgorin_dt(self, h: dict, X: np.ndarray) -> float:
-        """2/ω_max with ω_max² ≤ max_i R_i/m_i, R_i the absolute row sums of the stiffness (METHOD §1.7)."""
+        """2/ω_max with ω_max² ≤ max_i R_i/m_i, R_i the absolute row sums of the stiffness: CST, springs and, for a
+        breakable rock, one block contact per node (METHOD §1.7)."""
         row = element_row_sums(X, self.lam, self.mu)              # [N, 2]
         pn = self.topology.pair_nodes
         nrm = np.repeat(h["iface_normal"], 2, axis=0)
@@ -227,12 +228,13 @@ class ModelBuilder:
         cross = np.abs(kn - ks) * np.abs(nx * ny)
         rx = 2.0 * (kn * nx**2 + ks * ny**2 + cross)
         ry = 2.0 * (kn * ny**2 + ks * nx**2 + cross)
-        if not self.scenario.rock.unbreakable:
-            # allowance for one node-to-edge block contact of the same stiffness (METHOD §1.5)
-            rx, ry = 2.0 * rx, 2.0 * ry
         for col in (0, 1):
             np.add.at(row[:, 0], pn[:, col], rx)
             np.add.at(row[:, 1], pn[:, col], ry)
+        if not self.scenario.rock.unbreakable:
+            # allowance for one node-to-edge block contact at each node (METHOD §1.5, §1.7): 2·K_c in each row,
+            # K_c = k_c·t_n, the contact stiffness per area block contact uses and the node's tributary length
+            row += 2.0 * (contact_stiffness_per_area(h) * node_tributary_length(X))[:, None]
         omega2 = np.max(row / h["node_mass_dt"][:, None])
         # a dashpot of ratio ζ on the stiffest mode lowers the central-difference limit to
         # (2/ω)(√(1+ζ²) − ζ) (Belytschko, Liu & Moran, Nonlinear FE, §6.3)
@@ -344,6 +346,18 @@ def cst_stiffness(X: np.ndarray, lam: float, mu: float) -> np.ndarray:
     B[:, 2, 1::2] = b
     D = np.array([[lam + 2 * mu, lam, 0], [lam, lam + 2 * mu, 0], [0, 0, mu]])
     return area[:, None, None] * np.einsum("eki,kl,elj->eij", B, D, B)
+
+
+def contact_stiffness_per_area(h: dict) -> float:
+    """Block contact's penalty stiffness per area k_c [Pa/m]: the mean of the springs' k_n per area (cdem/contact.py;
+    0 without springs). One value for the whole rock, so on a graded mesh it is below the fine zone's springs."""
+    return float(np.mean(h["pair_kn_area"])) if len(h["pair_kn_area"]) else 0.0
+
+
+def node_tributary_length(X: np.ndarray) -> np.ndarray:
+    """Half of each of its element's two edges at each block node [m], shape [N] (X: [N, 2], nodes 3e + k)."""
+    L = np.linalg.norm(np.roll(X.reshape(-1, 3, 2), -1, axis=1) - X.reshape(-1, 3, 2), axis=2)   # edge k: k → k+1
+    return (0.5 * (L + np.roll(L, 1, axis=1))).reshape(-1)
 
 
 def element_row_sums(X: np.ndarray, lam: float, mu: float) -> np.ndarray:
