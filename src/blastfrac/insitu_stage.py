@@ -21,9 +21,9 @@ def relax_insitu(sim, progress=None) -> dict:
     if not ins.allow_failure:
         sim.model.breakable = 0
     saved_alpha, sim.alpha = sim.alpha, ins.damping
-    # at least two P-wave transits of the domain before the criterion is trusted
+    # at least insitu.min_transits P-wave transits of the domain before the criterion is trusted
     span = float(np.ptp(sim.model.host["node_X"], axis=0).max())
-    min_steps = int(2 * span / sim.scenario.rock.p_wave_speed / sim.dt) + 1
+    min_steps = int(ins.min_transits * span / sim.scenario.rock.p_wave_speed / sim.dt) + 1
     limit = ins.max_steps if sim.max_steps is None else min(ins.max_steps, sim.max_steps)   # --max-steps too
     task = progress.add_task("in-situ relaxation", total=limit) if progress else None
     while not converged and steps < limit:
