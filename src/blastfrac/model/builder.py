@@ -231,7 +231,8 @@ class ModelBuilder:
         for col in (0, 1):
             np.add.at(row[:, 0], pn[:, col], rx)
             np.add.at(row[:, 1], pn[:, col], ry)
-        if not self.scenario.rock.unbreakable:
+        rock = self.scenario.rock
+        if not rock.unbreakable and rock.block_contact:
             # allowance for one node-to-edge block contact at each node (METHOD §1.5, §1.7): 2·K_c in each row,
             # K_c = k_c·t_n, the contact stiffness per area block contact uses and the node's tributary length
             row += 2.0 * (contact_stiffness_per_area(h) * node_tributary_length(X))[:, None]
