@@ -7,7 +7,7 @@ import pytest
 from blastfrac.analysis.energy import budget_error, rock_energies
 from blastfrac.cdem.solver import CDEMSolver
 from blastfrac.geometry.mesh import TriMesh
-from blastfrac.model.builder import ModelBuilder
+from blastfrac.model.builder import ModelBuilder, node_tributary_length
 from blastfrac.model.model import CONTACT_DISSIPATED
 from blastfrac.simulation import Simulation
 from conftest import scenario
@@ -265,3 +265,11 @@ def test_model_step_covers_contact_stiffness():
     bound = CDEMSolver(m).contact.stable_dt()
     print(f"stable step {m.stable_dt:.4e} s, bound with every spring intact and every node in contact {bound:.4e} s")
     assert m.stable_dt <= bound
+    # the allowance is the contact's own: each node's tributary length is half of its element's two edges at it, so
+    # over all nodes they sum to the elements' perimeters, and without block contact there is none to allow for
+    perimeters = m.mesh.edge_lengths().sum()
+    assert abs(node_tributary_length(m.host["node_X"]).sum() - perimeters) <= 1e-12 * perimeters
+    off = ModelBuilder(scenario(rock={"unbreakable": False, "block_contact": False},
+                                geometry=sc.geometry.model_dump())).stable_dt
+    print(f"without block contact {off:.4e} s")
+    assert off > m.stable_dt

@@ -219,7 +219,7 @@ class ModelBuilder:
 
     def _gershgorin_dt(self, h: dict, X: np.ndarray) -> float:
         """2/ω_max with ω_max² ≤ max_i R_i/m_i, R_i the absolute row sums of the stiffness: CST, springs and, for a
-        breakable rock, one block contact per node (METHOD §1.7)."""
+        breakable rock with block contact, one block contact per node (METHOD §1.7)."""
         row = element_row_sums(X, self.lam, self.mu)              # [N, 2]
         pn = self.topology.pair_nodes
         nrm = np.repeat(h["iface_normal"], 2, axis=0)
