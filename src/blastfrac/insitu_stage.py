@@ -12,6 +12,13 @@ from .analysis.energy import rock_energies
 from .analysis.insitu import wall_stress_check
 
 
+def relaxation_floor(model, scenario, dt: float) -> int:
+    """The least number of relaxation steps of Δt = dt [s]: insitu.min_transits P-wave transits of the domain's
+    extent, after which the tolerance is trusted."""
+    span = float(np.ptp(model.host["node_X"], axis=0).max())
+    return int(scenario.insitu.min_transits * span / scenario.rock.p_wave_speed / dt) + 1
+
+
 def relax_insitu(sim, progress=None) -> dict:
     """Initialise σ⁰, apply consistent tractions and relax quasi-statically (METHOD §1.8)."""
     ins = sim.scenario.insitu
@@ -21,9 +28,7 @@ def relax_insitu(sim, progress=None) -> dict:
     if not ins.allow_failure:
         sim.model.breakable = 0
     saved_alpha, sim.alpha = sim.alpha, ins.damping
-    # at least insitu.min_transits P-wave transits of the domain before the criterion is trusted
-    span = float(np.ptp(sim.model.host["node_X"], axis=0).max())
-    min_steps = int(ins.min_transits * span / sim.scenario.rock.p_wave_speed / sim.dt) + 1
+    min_steps = relaxation_floor(sim.model, sim.scenario, sim.dt)
     limit = ins.max_steps if sim.max_steps is None else min(ins.max_steps, sim.max_steps)   # --max-steps too
     task = progress.add_task("in-situ relaxation", total=limit) if progress else None
     while not converged and steps < limit:

@@ -97,12 +97,13 @@ def run(args) -> int:
     steps = math.ceil(sc.simulation.end_time / dt)
     insitu_text = "no"
     if sc.insitu.active:
-        import numpy as np
+        from ..insitu_stage import relaxation_floor
 
-        span = float(np.ptp(m.host["node_X"], axis=0).max())
-        lo = int(2 * span / sc.rock.p_wave_speed / (sc.simulation.dt_safety * m.stable_dt)) + 1
+        lo = relaxation_floor(m, sc, sc.simulation.dt_safety * m.stable_dt)
         insitu_text = (f"{sc.insitu.method}: {'no relaxation' if sc.insitu.method == 'initial' else f'{lo:,} to {sc.insitu.max_steps:,} steps'}"
-                       f" (at least two P-wave transits, then until KE/U < {sc.insitu.tolerance:g})")
+                       f" (at least {sc.insitu.min_transits:g} P-wave transit{'' if sc.insitu.min_transits == 1 else 's'} of the domain, "
+                       f"then until KE/U < "
+                       f"{sc.insitu.tolerance:g})")
     rows = [
         ("title", sc.title or "-"),
         ("device", sc.simulation.device),
