@@ -25,9 +25,9 @@ DEVICE_PATTERN = re.compile(r"^(cpu|cuda(?::([0-9]+))?)$")
 def init_warp() -> None:
     """Initialise Warp once, without its start-up banner."""
     wp.config.log_level = wp.LOG_WARNING
-    # no kernel is differentiated (no wp.Tape anywhere): without the adjoint code a cold kernel cache compiles in a
-    # third of the time (the demo's first run: 36.8 -> 12.3 s) and the forward code is the same to the bit
-    wp.config.enable_backward = False
+    # blastfrac differentiates no kernel, so each of its kernel modules sets enable_backward = False for itself (a
+    # cold kernel cache then compiles the demo's first run in 12 s instead of 37 s; the forward code is the same to
+    # the bit); Warp's global default stays as it is for any kernels of the caller's own
     # Warp's native layer prints a warning on machines without a CUDA driver; CPU runs are the
     # normal case here, so hide that one message by muting file descriptor 2 during init.
     sys.stderr.flush()

@@ -20,6 +20,8 @@ import warp as wp
 
 from .._warp import Launcher
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.kernel
 def accumulate_wall_impulse(nodes: wp.array(dtype=wp.int32), hole: wp.array(dtype=wp.int32),

@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.func
 def platen_contact_force(x: wp.vec2d, apex_y: wp.float64, side: wp.float64, radius: wp.float64,

@@ -22,6 +22,8 @@ from .contact_geometry import (
     vec5d,
 )
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.func
 def corner_inside(

@@ -19,6 +19,8 @@ from .contact_geometry import (
     vec6d,
 )
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.kernel
 def compute_edge_samples(

@@ -22,6 +22,8 @@ from .contact_geometry import (
 )
 from .contact_hash import hash_search
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.func
 def add_contact(n: wp.int32, ia: wp.int32, ib: wp.int32, force: wp.vec2d, xi: wp.float64, pen: wp.float64,

@@ -12,6 +12,8 @@ import warp as wp
 from ..materials.artificial_viscosity import bulk_viscosity
 from ..materials.elastic import jaumann_stress_update
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.func
 def spring_force_sum(acc: wp.vec2d, code: wp.vec2i, pair_force: wp.array(dtype=wp.vec2d)):

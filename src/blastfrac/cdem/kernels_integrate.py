@@ -26,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.func
 def sign0(x: wp.float64):

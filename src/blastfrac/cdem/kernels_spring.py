@@ -15,6 +15,8 @@ import warp as wp
 
 from ..materials.interface import spring_dashpot_of, spring_update_broken, spring_update_intact
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 
 @wp.func
 def stored_spring_energy(fn: wp.float64, fs: wp.float64, kn: wp.float64, ks: wp.float64):

@@ -9,6 +9,8 @@ from blastfrac.mpm.bodies import MAT_GAS
 from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap,
                             pressure_offset, vertex_overlap)
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 # slots of the coupling's energy accumulator
 ACC_ABSORBED = wp.constant(0)   # work absorbed by the contacts since the start, −∫(P_gas + P_rock) dt [J/m]
 ACC_STORED = wp.constant(1)     # penalty energy ½k_c·δ² stored in the contacts at this step [J/m]

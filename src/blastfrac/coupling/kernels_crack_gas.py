@@ -20,6 +20,8 @@ import warp as wp
 from blastfrac.materials.crack_flow import crack_mass_flux
 from blastfrac.materials.jwl import V_FLOOR, jwl_pressure, jwl_sound_speed_sq
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 F64 = wp.float64
 
 #: a path moves at most this fraction of the mass that would equalise its two pressures in one step, estimated

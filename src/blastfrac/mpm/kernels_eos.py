@@ -11,6 +11,8 @@ from blastfrac.materials.jwl import jwl_energy_update, jwl_sound_speed_sq, produ
 from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.burn import burn_fraction
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 F64 = wp.float64
 
 

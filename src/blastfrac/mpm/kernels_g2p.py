@@ -9,6 +9,8 @@ from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.kernels_p2g import particle_stencil
 from blastfrac.mpm.shape import GridGeometry, wrap_index
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 F64 = wp.float64
 
 

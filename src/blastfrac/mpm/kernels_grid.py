@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import warp as wp
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 F64 = wp.float64
 
 

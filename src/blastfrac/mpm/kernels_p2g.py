@@ -14,6 +14,8 @@ from blastfrac.mpm.apic import affine_from_moments, affine_inertia
 from blastfrac.mpm.bodies import MAT_GAS
 from blastfrac.mpm.shape import GridGeometry, stencil_1d, wrap_index
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 F64 = wp.float64
 
 

@@ -7,6 +7,8 @@ import warp as wp
 from blastfrac.materials.linear_elastic_mp import elastic_stress_update
 from blastfrac.mpm.bodies import MAT_ELASTIC
 
+wp.set_module_options({"enable_backward": False})     # no adjoint code: nothing here is differentiated
+
 F64 = wp.float64
 
 
