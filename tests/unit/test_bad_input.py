@@ -248,6 +248,7 @@ SET_CASES = [
      ["borehole_pressure[0].pulse.values[1]"]),
     ("in-situ NaN", P15, ["insitu.syy=nan"], ["insitu.syy", "finite"]),
     ("in-situ -inf", P15, ["insitu.sxx=-inf"], ["insitu.sxx"]),
+    ("in-situ floor negative", P15, ["insitu.min_transits=-1"], ["insitu.min_transits", "greater than or equal to 0"]),
     ("annulus zone NaN", BP, ["zones.0.r_outer=nan"], ["zones[0].r_outer"]),
     ("rectangle zone -inf", CONF, ["zones.3.xmin=-inf"], ["zones[3].xmin"]),
     ("snapshot time NaN", CIRC, ["output.snapshot_times=[6e-6, nan]"], ["output.snapshot_times[1]"]),
