@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..cdem.solver import CDEMSolver
+from ..model.builder import has_contact_allowance
 from .loading import Platens, ramped_displacement
 
 
@@ -124,8 +125,7 @@ def run_loading(spec, settings: LoadSettings, on_sample=None) -> LoadResult:
     # the builder's Gershgorin step of a breakable model allows for one block contact per node,
     # 2·k_c·t_n (METHOD §1.7; about four median spring stiffnesses on a uniform specimen mesh), which
     # covers the platen penalty; a model without it (unbreakable, or rock.block_contact off) takes a margin of 1/√2
-    allowance = m.breakable and spec.scenario.rock.block_contact
-    dt = s.dt_safety * m.stable_dt * (1.0 if allowance else 1.0 / math.sqrt(2.0))
+    dt = s.dt_safety * m.stable_dt * (1.0 if has_contact_allowance(spec.scenario.rock) else 1.0 / math.sqrt(2.0))
     cp = spec.scenario.rock.p_wave_speed
     t_ramp = s.ramp_transits * spec.height / cp
     every = max(1, int(round(s.sample_strain * spec.height / (2 * s.speed * dt))))

@@ -231,8 +231,7 @@ class ModelBuilder:
         for col in (0, 1):
             np.add.at(row[:, 0], pn[:, col], rx)
             np.add.at(row[:, 1], pn[:, col], ry)
-        rock = self.scenario.rock
-        if not rock.unbreakable and rock.block_contact:
+        if has_contact_allowance(self.scenario.rock):
             # allowance for one node-to-edge block contact at each node (METHOD §1.5, §1.7): 2·K_c in each row,
             # K_c = k_c·t_n, the contact stiffness per area block contact uses and the node's tributary length
             row += 2.0 * (contact_stiffness_per_area(h) * node_tributary_length(X))[:, None]
@@ -347,6 +346,12 @@ def cst_stiffness(X: np.ndarray, lam: float, mu: float) -> np.ndarray:
     B[:, 2, 1::2] = b
     D = np.array([[lam + 2 * mu, lam, 0], [lam, lam + 2 * mu, 0], [0, 0, mu]])
     return area[:, None, None] * np.einsum("eki,kl,elj->eij", B, D, B)
+
+
+def has_contact_allowance(rock) -> bool:
+    """Whether the stable step of a model of ``rock`` (a RockConfig) allows for one block contact per node: the rock
+    can break and block contact is on (METHOD §1.7)."""
+    return not rock.unbreakable and rock.block_contact
 
 
 def contact_stiffness_per_area(h: dict) -> float:
