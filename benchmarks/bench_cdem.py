@@ -30,7 +30,10 @@ def _scenario(n_elements: int):
     })
 
 
-def run(sizes=(50_000, 200_000, 800_000), steps: int = 20, device: str = "cpu") -> list[dict]:
+def run(sizes=(50_000, 200_000, 800_000), steps: int = 20, device: str = "cpu", reps: int = 5) -> list[dict]:
+    """Time ``reps`` consecutive blocks of ``steps`` steps per size and keep the median block (as the compiled
+    reference times itself: a single block on a shared VM can be 1.5x off); ``spread`` is the slowest block over
+    the fastest."""
     import warp as wp
 
     from blastfrac._warp import init_warp
@@ -47,13 +50,18 @@ def run(sizes=(50_000, 200_000, 800_000), steps: int = 20, device: str = "cpu") 
         solver.forces(st, dt, 0.0)                    # warm-up (kernel load)
         solver.integrate(st, dt)
         wp.synchronize_device(device)
-        t0 = time.perf_counter()
-        for k in range(steps):
-            solver.forces(st, dt, k * dt)
-            solver.integrate(st, dt)
-        wp.synchronize_device(device)
-        wall = time.perf_counter() - t0
+        walls, k = [], 1
+        for _ in range(max(1, reps)):
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                solver.forces(st, dt, k * dt)
+                solver.integrate(st, dt)
+                k += 1
+            wp.synchronize_device(device)
+            walls.append(time.perf_counter() - t0)
+        wall = float(np.median(walls))
         rows.append({"elements": m.element_count, "springs": m.spring_count, "steps": steps, "wall_s": wall,
+                     "reps": len(walls), "spread": max(walls) / min(walls),
                      "element_steps_per_s": m.element_count * steps / wall, "device": device})
     return rows
 

@@ -244,7 +244,7 @@ def run_reference(src: Path, steps: int = 20, device: str = "cpu") -> list[dict]
     bc = bench_cdem.run((200_000,), steps, device)[0]
     rows.append({"loop": "CDEM", "size": bc["elements"], "blastfrac_per_s": bc["element_steps_per_s"],
                  "reference_per_s": rc["units_steps_per_s"], "reference_size": rc.get("elements", 199_712),
-                 "reference": rc})
+                 "reference": rc, "spread": bc["spread"]})
     # the reference's own algorithm in Warp kernels (benchmarks/reference_port.py): Warp's code against g++'s,
     # and so how much of blastfrac ÷ C++ is blastfrac's extra work
     port = reference_port.run(dst, device=device)
@@ -255,7 +255,8 @@ def run_reference(src: Path, steps: int = 20, device: str = "cpu") -> list[dict]
         rm = ref("mpm", str(n), scatter="private")
         bm = bench_mpm.run((n,), steps, device)[0]
         rows.append({"loop": "MPM", "size": bm["n_particles"], "blastfrac_per_s": bm["particle_steps_per_s"],
-                     "reference_per_s": rm["units_steps_per_s"], "reference_size": n, "reference": rm})
+                     "reference_per_s": rm["units_steps_per_s"], "reference_size": n, "reference": rm,
+                     "spread": bm["spread"]})
         mp = reference_port.run_mpm(dst, n, device=device)
         rows.append({"loop": "MPM, the reference's algorithm in Warp", "size": n,
                      "blastfrac_per_s": mp["port_units_steps_per_s"], "reference_per_s": mp["cpp_units_steps_per_s"],
@@ -273,6 +274,10 @@ def reference_markdown(rows: list[dict]) -> str:
         out.append(f"| {r['loop']} | {r['size']:,} | {r['blastfrac_per_s']:.3e} | {r['reference_per_s']:.3e} "
                    f"| {r['ratio_time_per_unit']:.2f} |")
     out.append("")
+    spread = [f"{r['loop']} {r['size']:,} {r['spread']:.2f}" for r in rows if "spread" in r]
+    out.append("Each figure is the median of 5 timed blocks (blastfrac: 5 consecutive blocks of the steps given; the C++ "
+               "program and the port: 5 runs from the same start); blastfrac's slowest block over its fastest: "
+               + ", ".join(spread) + ".")
     for loop, unit in (("CDEM", "element"), ("MPM", "particle")):
         fulls = [r for r in rows if r["loop"] == loop]
         ports = [r for r in rows if r["loop"].startswith(f"{loop}, the reference")]

@@ -29,8 +29,10 @@ def _solver(n_particles: int, device: str):
     return MPMSolver(cfg, device=device)
 
 
-def run(sizes=(100_000, 400_000, 1_600_000), steps: int = 20, device: str = "cpu") -> list[dict]:
-    """Time ``steps`` MUSL steps per size; returns dicts n_particles, steps, wall_s, particle_steps_per_s."""
+def run(sizes=(100_000, 400_000, 1_600_000), steps: int = 20, device: str = "cpu", reps: int = 5) -> list[dict]:
+    """Time ``reps`` consecutive blocks of ``steps`` steps per size and keep the median block (as the compiled
+    reference times itself); returns dicts n_particles, steps, wall_s (the median block), reps, spread (slowest
+    block over the fastest), particle_steps_per_s."""
     import warp as wp
 
     out = []
@@ -39,14 +41,17 @@ def run(sizes=(100_000, 400_000, 1_600_000), steps: int = 20, device: str = "cpu
         dt = s.stable_dt()
         s.step(dt, 0.0)  # warm-up (kernel load)
         wp.synchronize_device(s.device)
-        t0 = time.perf_counter()
-        t = dt
-        for _ in range(steps):
-            s.step(dt, t)
-            t += dt
-        wp.synchronize_device(s.device)
-        wall = time.perf_counter() - t0
-        out.append({"n_particles": s.n, "steps": steps, "wall_s": wall, "particle_steps_per_s": s.n * steps / wall})
+        walls, t = [], dt
+        for _ in range(max(1, reps)):
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                s.step(dt, t)
+                t += dt
+            wp.synchronize_device(s.device)
+            walls.append(time.perf_counter() - t0)
+        wall = float(np.median(walls))
+        out.append({"n_particles": s.n, "steps": steps, "wall_s": wall, "reps": len(walls),
+                    "spread": max(walls) / min(walls), "particle_steps_per_s": s.n * steps / wall})
     return out
 
 

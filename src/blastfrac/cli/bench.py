@@ -52,18 +52,20 @@ def run(args) -> int:
         sizes = (5_000, 20_000) if args.quick else (50_000, 200_000, 800_000)
         rows = cdem.run(sizes, args.steps, device)
         print(f"CDEM on {device} (float64, all rock terms on)")
-        print("| elements | springs | steps | wall [s] | element-steps/s |")
+        print("| elements | springs | steps | wall [s] (median block) | blocks slowest / fastest | element-steps/s |")
         for r in rows:
-            print(f"| {r['elements']:,} | {r['springs']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['element_steps_per_s']:.3e} |")
+            print(f"| {r['elements']:,} | {r['springs']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['spread']:.2f} "
+                  f"| {r['element_steps_per_s']:.3e} |")
         print(f"scaling slope: {cdem.scaling_slope(rows, 'elements'):.3f}\n")
     if args.only in (None, "mpm"):
         mpm = _load("bench_mpm")
         sizes = (10_000, 40_000) if args.quick else (100_000, 400_000, 1_600_000)
         rows = mpm.run(sizes, args.steps, device)
         print(f"MPM on {device} (float64, full MUSL step)")
-        print("| particles | steps | wall [s] | particle-steps/s |")
+        print("| particles | steps | wall [s] (median block) | blocks slowest / fastest | particle-steps/s |")
         for r in rows:
-            print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['particle_steps_per_s']:.3e} |")
+            print(f"| {r['n_particles']:,} | {r['steps']} | {r['wall_s']:.3f} | {r['spread']:.2f} "
+                  f"| {r['particle_steps_per_s']:.3e} |")
         print(f"scaling slope: {_load('bench_cdem').scaling_slope(rows, 'n_particles'):.3f}")
         widths = (0.06, 0.24) if args.quick else (0.06, 0.12, 0.24, 0.48)
         print(f"\nMPM active node box on {device}: the demo's charge (1,257 points, 0.5 mm cells) in larger grids")
