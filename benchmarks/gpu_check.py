@@ -13,6 +13,11 @@ GPU's runs agree with the CPU's.
    fracture degree D within 2 % (relative), the energy budget within 1 % (each energy term's difference as a share
    of the explosive energy released, and the budget errors' difference).
 
+On a lent machine (``../.library/device``), which lacks Warp, gmsh and pydantic and carries 64 MiB a call, the
+dependencies travel in parts (``benchmarks/gpu_pack.py``) and ``benchmarks/gpu_device.sh`` unpacks them and runs this
+with ``--skip-cpu``; ``--compare JSON`` then runs the CPU side of the same cases on the developer's machine and
+writes the agreement, so that no device time goes to CPU runs.
+
 The GPU's atomics add in another order than the CPU's, and fracture amplifies round-off, so the runs are compared by
 these measures, not to the bit. Writes DIR/gpu_check.json and DIR/gpu_check.md (default DIR: $OUT, else
 out/gpu_check) and prints the markdown. ``--quick``: small sizes and short runs, to try the script (on a CPU with
@@ -95,6 +100,27 @@ def markdown(res: dict) -> str:
     return "\n".join(lines)
 
 
+def compare(gpu_json: Path, out: Path) -> int:
+    """The CPU side of the agreement check, run on this machine after a GPU session (gpu_device.sh ran the GPU side
+    with --skip-cpu, at the device's expense only for the GPU): each case of the GPU run on the CPU (two threads, the
+    same step limit), then the agreement table; writes OUT/gpu_check.json and OUT/gpu_check.md."""
+    res = json.loads(gpu_json.read_text())
+    quick = bool(res.get("quick", False))
+    device_runs = list(res["runs"])                 # every run of the file was made on the device (--skip-cpu)
+    for case in dict.fromkeys(r["case"] for r in device_runs):
+        gpu = [r for r in device_runs if r["case"] == case]
+        cpu = _run_case(case, "cpu", "auto", 2, 300 if quick else None)
+        cpu["host"] = platform.node()
+        res["runs"].append(cpu)
+        res["agreement"] += [{"case": case, "graph": r["graph"], **agreement(cpu, r)} for r in gpu]
+    text = markdown(res)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "gpu_check.json").write_text(json.dumps(res, indent=1, default=str))
+    (out / "gpu_check.md").write_text(text + "\n")
+    print(text)
+    return 0 if all(a["ok"] for a in res["agreement"]) else 1
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--device", default="cuda:0")
@@ -103,7 +129,12 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="small sizes, 300-step runs (to try the script)")
     ap.add_argument("--skip-cpu", action="store_true", help="no CPU runs (no agreement check)")
     ap.add_argument("--large", action="store_true", help="also 2 M elements and 6.4 M points")
+    ap.add_argument("--compare", metavar="JSON", default=None,
+                    help="a GPU run's gpu_check.json (made with --skip-cpu on the device): run its cases on this "
+                         "machine's CPU and write the agreement beside the GPU figures in --out")
     args = ap.parse_args(argv)
+    if args.compare:
+        return compare(Path(args.compare), Path(args.out))
     import warp as wp
 
     from blastfrac._warp import init_warp, resolve_device
@@ -111,7 +142,8 @@ def main(argv=None) -> int:
     init_warp()
     device = resolve_device(args.device)
     res = {"device": device, "device_name": wp.get_device(device).name, "warp": wp.__version__,
-           "date": time.strftime("%Y-%m-%d %H:%M"), "host": platform.node(), "runs": [], "agreement": []}
+           "date": time.strftime("%Y-%m-%d %H:%M"), "host": platform.node(), "runs": [], "agreement": [],
+           "quick": args.quick}
     t0 = time.perf_counter()
     big = args.large and not args.quick
     res["cdem"] = bench_cdem.run((20_000,) if args.quick else (1_000_000, 2_000_000)[: 1 + big], args.steps, device)

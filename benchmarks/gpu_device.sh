@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Issue 14 item 6 on a lent GPU machine, run from the repository root there: unpack the dependencies carried in
+# .gpu/p1 ... .gpu/pN (benchmarks/gpu_pack.py: one call per part on the warm machine, this script in the call that
+# carries the last), then gpu_check.py on the GPU alone (its CPU side runs here afterwards, at no device time:
+# python benchmarks/gpu_check.py --compare <the fetched gpu_check.json>). Extra arguments go to gpu_check.py.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SITE=/tmp/site
+if [ ! -d "$SITE/warp" ]; then
+    python3 benchmarks/gpu_pack.py --unpack "$SITE"
+fi
+export PYTHONPATH="$SITE:$PWD/src"
+nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv,noheader || true
+python3 -c "import warp as wp; wp.init(); print('warp', wp.__version__, [d.name for d in wp.get_cuda_devices()])"
+python3 benchmarks/gpu_check.py --device cuda:0 --skip-cpu --out "${OUT:-out/gpu_check}" "$@"

@@ -1,0 +1,184 @@
+"""Carry blastfrac's Python dependencies to a lent GPU machine, and unpack them there (issue 14, item 6).
+
+The lent machines (``../.library/device``: H100 / H200, Python 3.12, no network) hold numpy, scipy, matplotlib and
+rich, but not Warp, gmsh, pydantic, meshio or tomli-w, and a call carries at most 64 MiB, the working tree
+included (~21 MB). Warp's wheel alone is 149 MB (its CUDA library, 299 MB unpacked). So:
+
+1. here, at no device time: ``python benchmarks/gpu_pack.py`` downloads the wheels of the versions installed here
+   for CPython 3.12 on manylinux x86-64, installs them into a staging folder, drops what a run does not read
+   (Warp's examples, gmsh's docs and headers), and writes it as one xz-compressed tar split into parts of at most
+   ``--part-mib`` MiB, ``.gpu/p1`` … ``.gpu/pN`` (``.gpu/`` is in .gitignore; ~3 minutes on 2 cores);
+2. on the device, one call per part while the machine stays warm (it keeps ignored paths between calls; it is given
+   back after 30 s idle): ``run(command="true", carry=[".gpu/p1"])``, … and the last part with the work itself:
+   ``run(command="bash benchmarks/gpu_device.sh", carry=[".gpu/pN"], timeout_s=...)``;
+3. ``gpu_device.sh`` calls ``python3 benchmarks/gpu_pack.py --unpack /tmp/site`` (standard library only: it joins
+   the parts in order and checks the total size and SHA-256 written beside them), sets PYTHONPATH and runs
+   ``gpu_check.py --skip-cpu``; the CPU side of the agreement check then runs here
+   (``python benchmarks/gpu_check.py --compare DIR``), at no device time.
+
+``python benchmarks/gpu_pack.py --python-version 3.11 --check`` builds a pack for this machine's Python, unpacks it
+into a scratch folder and imports Warp, gmsh, pydantic, meshio and tomli-w from there, and runs one Warp kernel on
+the CPU: the round trip that the device depends on, tried at no device time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tarfile
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACK = ROOT / ".gpu"
+#: the distributions blastfrac needs that the lent machines lack (``../.library/device/KINDS.md``)
+NEEDED = ("warp-lang", "gmsh", "meshio", "pydantic", "pydantic-core", "annotated-types", "typing-inspection",
+          "typing-extensions", "tomli-w")
+#: platform tags pip may match for the device's x86-64 Linux (the device README's list)
+PLATFORMS = ("manylinux_2_28_x86_64", "manylinux_2_27_x86_64", "manylinux_2_24_x86_64", "manylinux_2_17_x86_64",
+             "manylinux2014_x86_64", "manylinux1_x86_64")
+#: what no run reads: dropped from the staging folder before packing
+DROP = ("warp/examples", "warp/tests", "share/doc", "include", "lib/cmake")
+
+
+def installed_versions() -> dict[str, str]:
+    """The installed version of each NEEDED distribution (this machine's environment is the tested one)."""
+    from importlib.metadata import version
+
+    return {name: version(name) for name in NEEDED}
+
+
+def build(python_version: str, part_mib: int, out: Path = PACK) -> list[Path]:
+    """Download, stage and pack the dependencies for CPython ``python_version``; returns the part folders."""
+    pins = [f"{n}=={v}" for n, v in installed_versions().items()]
+    plat = [a for p in PLATFORMS for a in ("--platform", p)]
+    with tempfile.TemporaryDirectory() as tmp:
+        wheels, stage = Path(tmp) / "wheels", Path(tmp) / "site"
+        common = ["--no-deps", "--only-binary=:all:", "--python-version", python_version, "--implementation", "cp",
+                  *plat]
+        subprocess.run([sys.executable, "-m", "pip", "download", "-q", *common, "-d", str(wheels), *pins], check=True)
+        subprocess.run([sys.executable, "-m", "pip", "install", "-q", *common, "--no-index", "--no-compile",
+                        "--target", str(stage), *map(str, sorted(wheels.glob("*.whl")))], check=True)
+        # pip --target keeps a wheel's platlib and scripts but not its data folder's lib/ (gmsh's libgmsh.so, which
+        # gmsh.py looks for in <site>/lib): copy those libraries in from the wheels
+        import zipfile
+
+        for whl in wheels.glob("*.whl"):
+            with zipfile.ZipFile(whl) as z:
+                for info in z.infolist():
+                    parts = info.filename.split("/")
+                    if len(parts) == 4 and parts[0].endswith(".data") and parts[1:3] == ["data", "lib"] and parts[3]:
+                        dst = stage / "lib" / parts[3]
+                        dst.parent.mkdir(exist_ok=True)
+                        dst.write_bytes(z.read(info))
+        for rel in DROP:
+            shutil.rmtree(stage / rel, ignore_errors=True)
+        blob = Path(tmp) / "site.tar.xz"
+        # xz from the command line uses both cores (Python's lzma one); -6: -9 saved 4 % of Warp's library for 2x
+        with open(blob, "wb") as f:
+            tar = subprocess.Popen(["tar", "-C", str(stage), "-cf", "-", "."], stdout=subprocess.PIPE)
+            subprocess.run(["xz", "-T0", "-6", "-c"], stdin=tar.stdout, stdout=f, check=True)
+            if tar.wait() != 0:
+                raise RuntimeError("tar failed")
+        shutil.rmtree(out, ignore_errors=True)
+        size, digest, parts = blob.stat().st_size, hashlib.sha256(blob.read_bytes()).hexdigest(), []
+        step = part_mib << 20
+        with open(blob, "rb") as f:
+            k = 0
+            while chunk := f.read(step):
+                k += 1
+                d = out / f"p{k}"
+                d.mkdir(parents=True)
+                (d / f"part{k:02d}").write_bytes(chunk)
+                parts.append(d)
+        manifest = {"python": python_version, "pins": pins, "bytes": size, "sha256": digest, "parts": len(parts)}
+        (parts[-1] / "manifest.json").write_text(json.dumps(manifest, indent=1))
+    return parts
+
+
+def tree_bytes() -> int:
+    """Bytes of what a device call sends besides the carried paths: tracked and untracked-not-ignored files."""
+    names = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=ROOT,
+                           capture_output=True, check=True).stdout.split(b"\0")
+    return sum((ROOT / n.decode()).stat().st_size for n in names if n and (ROOT / n.decode()).is_file())
+
+
+def unpack(target: Path, src: Path = PACK) -> dict:
+    """Join the parts in order, check size and SHA-256 against the manifest, and extract into ``target``. Standard
+    library only (it runs on the device before anything is installed)."""
+    manifest = json.loads(next(src.glob("p*/manifest.json")).read_text())
+    parts = sorted(src.glob("p*/part*"), key=lambda p: p.name)
+    if len(parts) != manifest["parts"]:
+        raise SystemExit(f"{len(parts)} of {manifest['parts']} parts here: carry each .gpu/pK on a warm machine")
+    h, n = hashlib.sha256(), 0
+    with tempfile.TemporaryFile() as f:
+        for p in parts:
+            b = p.read_bytes()
+            h.update(b)
+            n += len(b)
+            f.write(b)
+        if n != manifest["bytes"] or h.hexdigest() != manifest["sha256"]:
+            raise SystemExit(f"the parts do not join to the pack ({n} of {manifest['bytes']} bytes, or the digest)")
+        f.seek(0)
+        target.mkdir(parents=True, exist_ok=True)
+        with tarfile.open(fileobj=f, mode="r:xz") as t:
+            t.extractall(target, filter="data") if sys.version_info >= (3, 12) else t.extractall(target)
+    return manifest
+
+
+def check(python_version: str, part_mib: int) -> None:
+    """Build a pack for this Python, unpack it into a scratch folder and use it: the round trip, at no device time."""
+    out = Path(os.environ.get("GPU_PACK_SCRATCH") or tempfile.mkdtemp(prefix="gpu_pack_"))
+    try:
+        parts = sorted((out / "pack").glob("p*")) if (out / "pack").is_dir() else build(python_version, part_mib,
+                                                                                             out / "pack")
+        print(f"{len(parts)} parts:", ", ".join(f"{p.name} {sum(f.stat().st_size for f in p.iterdir()) / 2**20:.1f} MiB"
+                                                for p in parts))
+        if not (out / "site").is_dir():
+            unpack(out / "site", out / "pack")
+        # Warp compiles kernels from files only: a blastfrac run (the unit tests' small bar) imports everything
+        code = ("import sys, warp as wp, gmsh, pydantic, meshio, tomli_w\n"
+                "assert all(m.__file__.startswith(sys.argv[1]) for m in (wp, gmsh, pydantic, meshio, tomli_w))\n"
+                "gmsh.initialize(); gmsh.finalize()\n"
+                "from blastfrac.cdem import kernels_spring\n"
+                "print('pack ok: warp', wp.__version__, 'gmsh', gmsh.__version__, 'from', sys.argv[1])")
+        script = out / "check_pack.py"
+        script.write_text(code)
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(out / "site"), str(ROOT / "src")])}
+        subprocess.run([sys.executable, str(script), str(out / "site")], env=env, check=True)
+        subprocess.run([sys.executable, "-m", "blastfrac", "run", str(ROOT / "examples/circular_rock/demo.toml"),
+                        "--set", "simulation.end_time=2e-7", "--set", "output.paraview=false",
+                        "--set", "output.figures=false", "--out", str(out / "run")], env=env, check=True)
+    finally:
+        if not os.environ.get("GPU_PACK_SCRATCH"):
+            shutil.rmtree(out, ignore_errors=True)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--python-version", default="3.12", help="the device's Python (KINDS.md: 3.12)")
+    ap.add_argument("--part-mib", type=int, default=None,
+                    help="largest part [MiB]; default: what a call's 64 MiB leaves beside the working tree, less 1")
+    ap.add_argument("--unpack", metavar="DIR", help="on the device: join the parts and extract them into DIR")
+    ap.add_argument("--check", action="store_true", help="build, unpack and import a pack here (scratch folders)")
+    a = ap.parse_args(argv)
+    if a.part_mib is None and not a.unpack:
+        a.part_mib = 63 - int(tree_bytes() / 2**20 + 0.999)
+    if a.unpack:
+        m = unpack(Path(a.unpack))
+        print(f"joined {m['parts']} parts ({m['bytes'] / 2**20:.1f} MiB) and unpacked: {' '.join(m['pins'])}")
+    elif a.check:
+        check(a.python_version, a.part_mib)
+    else:
+        parts = build(a.python_version, a.part_mib)
+        print("carry, one call each on a warm machine:", " ".join(str(p.relative_to(ROOT)) for p in parts))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
