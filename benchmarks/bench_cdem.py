@@ -30,10 +30,9 @@ def _scenario(n_elements: int):
     })
 
 
-def run(sizes=(50_000, 200_000, 800_000), steps: int = 20, device: str = "cpu", reps: int = 5) -> list[dict]:
-    """Time ``reps`` consecutive blocks of ``steps`` steps per size and keep the median block (as the compiled
-    reference times itself: a single block on a shared VM can be 1.5x off); ``spread`` is the slowest block over
-    the fastest."""
+def timer(n_elements: int, device: str = "cpu"):
+    """(info, block): the benchmark's model of about ``n_elements`` triangles, built and one step run (kernel load);
+    ``block(steps)`` runs that many more steps and returns their wall time [s], the device synchronised."""
     import warp as wp
 
     from blastfrac._warp import init_warp
@@ -41,28 +40,39 @@ def run(sizes=(50_000, 200_000, 800_000), steps: int = 20, device: str = "cpu", 
     from blastfrac.model.builder import ModelBuilder
 
     init_warp()
+    m = ModelBuilder(_scenario(n_elements)).finalize(device)
+    st, solver = m.state(), CDEMSolver(m)
+    solver.contact.active = True                  # all terms on, including the block-contact search
+    dt = 0.8 * m.stable_dt
+    solver.forces(st, dt, 0.0)                    # warm-up (kernel load)
+    solver.integrate(st, dt)
+    wp.synchronize_device(device)
+    k = [1]
+
+    def block(steps: int) -> float:
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            solver.forces(st, dt, k[0] * dt)
+            solver.integrate(st, dt)
+            k[0] += 1
+        wp.synchronize_device(device)
+        return time.perf_counter() - t0
+
+    return {"elements": m.element_count, "springs": m.spring_count, "units": m.element_count}, block
+
+
+def run(sizes=(50_000, 200_000, 800_000), steps: int = 20, device: str = "cpu", reps: int = 5) -> list[dict]:
+    """Time ``reps`` consecutive blocks of ``steps`` steps per size and keep the median block (as the compiled
+    reference times itself: a single block on a shared VM can be 1.5x off); ``spread`` is the slowest block over
+    the fastest."""
     rows = []
     for n in sizes:
-        m = ModelBuilder(_scenario(n)).finalize(device)
-        st, solver = m.state(), CDEMSolver(m)
-        solver.contact.active = True                  # all terms on, including the block-contact search
-        dt = 0.8 * m.stable_dt
-        solver.forces(st, dt, 0.0)                    # warm-up (kernel load)
-        solver.integrate(st, dt)
-        wp.synchronize_device(device)
-        walls, k = [], 1
-        for _ in range(max(1, reps)):
-            t0 = time.perf_counter()
-            for _ in range(steps):
-                solver.forces(st, dt, k * dt)
-                solver.integrate(st, dt)
-                k += 1
-            wp.synchronize_device(device)
-            walls.append(time.perf_counter() - t0)
+        info, block = timer(n, device)
+        walls = [block(steps) for _ in range(max(1, reps))]
         wall = float(np.median(walls))
-        rows.append({"elements": m.element_count, "springs": m.spring_count, "steps": steps, "wall_s": wall,
+        rows.append({"elements": info["elements"], "springs": info["springs"], "steps": steps, "wall_s": wall,
                      "reps": len(walls), "spread": max(walls) / min(walls),
-                     "element_steps_per_s": m.element_count * steps / wall, "device": device})
+                     "element_steps_per_s": info["elements"] * steps / wall, "device": device})
     return rows
 
 

@@ -17,13 +17,14 @@ ratio is blastfrac ÷ reference per element-step (particle-step).
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = {"demo": ("examples/circular_rock/demo.toml", ["geometry.mesh_size=0.006"]),
@@ -222,69 +223,73 @@ def markdown(rows: list[dict]) -> str:
 
 
 # ----------------------------------------------------------------------------- compiled reference
-def run_reference(src: Path, steps: int = 20, device: str = "cpu") -> list[dict]:
-    """Build the C++ reference in a scratch copy and run it beside blastfrac's CDEM and MPM benchmarks."""
+def run_reference(src: Path, steps: int = 20, device: str = "cpu", rounds: int = 5) -> list[dict]:
+    """Build the C++ reference in a scratch copy and compare blastfrac's CDEM and MPM kernels, and the reference's
+    own algorithm in Warp (benchmarks/reference_port.py), with it, per unit-step, one thread each.
+
+    Interleaved, so that a shared machine's changing load falls on all three alike: each of ``rounds`` rounds runs
+    one repetition of the C++ program (its own timing: reset, its 50 / 20 steps), then a block of ``steps`` of
+    blastfrac's steps, then one repetition of the port; each round gives its ratios, and a row holds their median
+    and range. (Timed one after the other, five repetitions each, two runs on the same VM gave Warp ÷ g++ of 1.25
+    and 0.96 for the same MPM loop, benchmarks/RESULTS.md, stop 32.)"""
     sys.path.insert(0, str(Path(__file__).parent))
     import bench_cdem
     import bench_mpm
     import reference_port
 
     dst = reference_port.build(src)
-    scratch = dst.parent
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-
-    def ref(*args, scatter):
-        r = subprocess.run(["./bench_cpp_f64", *args], cwd=dst, env={**env, "SCATTER": scatter},
-                           capture_output=True, text=True, check=True)
-        line = next(l for l in r.stdout.splitlines() if l.startswith("RESULT"))
-        return json.loads(line.split(" ", 1)[1])
-
+    problems = [("CDEM", ["cdem"], "colour", lambda: bench_cdem.timer(200_000, device), "cdem", 0)]
+    problems += [("MPM", ["mpm", str(n)], "private", lambda n=n: bench_mpm.timer(n, device), "mpm", n)
+                 for n in (100_000, 400_000)]
     rows = []
-    rc = ref("cdem", scatter="colour")
-    bc = bench_cdem.run((200_000,), steps, device)[0]
-    rows.append({"loop": "CDEM", "size": bc["elements"], "blastfrac_per_s": bc["element_steps_per_s"],
-                 "reference_per_s": rc["units_steps_per_s"], "reference_size": rc.get("elements", 199_712),
-                 "reference": rc, "spread": bc["spread"]})
-    # the reference's own algorithm in Warp kernels (benchmarks/reference_port.py): Warp's code against g++'s,
-    # and so how much of blastfrac ÷ C++ is blastfrac's extra work
-    port = reference_port.run(dst, device=device)
-    rows.append({"loop": "CDEM, the reference's algorithm in Warp", "size": port["triangles"],
-                 "blastfrac_per_s": port["port_units_steps_per_s"], "reference_per_s": port["cpp_units_steps_per_s"],
-                 "reference_size": port["triangles"], "reference": port})
-    for n in (100_000, 400_000):
-        rm = ref("mpm", str(n), scatter="private")
-        bm = bench_mpm.run((n,), steps, device)[0]
-        rows.append({"loop": "MPM", "size": bm["n_particles"], "blastfrac_per_s": bm["particle_steps_per_s"],
-                     "reference_per_s": rm["units_steps_per_s"], "reference_size": n, "reference": rm,
-                     "spread": bm["spread"]})
-        mp = reference_port.run_mpm(dst, n, device=device)
-        rows.append({"loop": "MPM, the reference's algorithm in Warp", "size": n,
-                     "blastfrac_per_s": mp["port_units_steps_per_s"], "reference_per_s": mp["cpp_units_steps_per_s"],
-                     "reference_size": n, "reference": mp})
-    for r in rows:
-        r["ratio_time_per_unit"] = r["reference_per_s"] / r["blastfrac_per_s"]
-    shutil.rmtree(scratch, ignore_errors=True)
+    try:
+        for loop, cpp_args, scatter, make_blastfrac, kind, n in problems:
+            b_info, b_block = make_blastfrac()
+            p_info, p_block, p_checks = reference_port.port_timer(dst, kind, n, device)
+            per_unit = {"cpp": [], "blastfrac": [], "port": []}     # seconds per unit-step, each round
+            rel = None
+            for r in range(rounds):
+                cpp = reference_port.cpp_once(dst, cpp_args, scatter)
+                per_unit["cpp"].append(1.0 / cpp["units_steps_per_s"])
+                per_unit["blastfrac"].append(b_block(steps) / steps / b_info["units"])
+                nst = int(cpp["nsteps"])
+                per_unit["port"].append(p_block(nst) / nst / p_info["units"])
+                if r == 0:                       # the port's state after one repetition against the C++ run's
+                    chk, ref = p_checks(), cpp["checks"]
+                    rel = max(abs(chk[k] - ref[k]) / max(abs(ref[k]), 1e-300) for k in chk)
+            t = {k: np.array(v) for k, v in per_unit.items()}
+            for who, size in (("blastfrac", b_info["units"]), ("port", p_info["units"])):
+                ratio = t[who] / t["cpp"]
+                rows.append({"loop": loop if who == "blastfrac" else f"{loop}, the reference's algorithm in Warp",
+                             "size": size, "blastfrac_per_s": 1.0 / float(np.median(t[who])),
+                             "reference_per_s": 1.0 / float(np.median(t["cpp"])),
+                             "ratio_time_per_unit": float(np.median(ratio)),
+                             "ratio_range": [float(ratio.min()), float(ratio.max())],
+                             "algorithm_ratio": float(np.median(t["blastfrac"] / t["port"])), "rounds": rounds,
+                             "reference": {"checks_max_rel_diff": rel, "cpp_last": cpp}})
+    finally:
+        shutil.rmtree(dst.parent, ignore_errors=True)
     return rows
 
 
 def reference_markdown(rows: list[dict]) -> str:
-    out = ["| loop | blastfrac size | blastfrac units-steps/s | C++ f64 1 thread units-steps/s | blastfrac ÷ C++ per unit-step |",
+    out = [("| loop | blastfrac size | blastfrac units-steps/s | C++ f64 1 thread units-steps/s "
+            "| blastfrac ÷ C++ per unit-step: median (range) of the rounds |"),
            "|---|---:|---:|---:|---:|"]
     for r in rows:
+        lo, hi = r["ratio_range"]
         out.append(f"| {r['loop']} | {r['size']:,} | {r['blastfrac_per_s']:.3e} | {r['reference_per_s']:.3e} "
-                   f"| {r['ratio_time_per_unit']:.2f} |")
+                   f"| {r['ratio_time_per_unit']:.2f} ({lo:.2f}–{hi:.2f}) |")
     out.append("")
-    spread = [f"{r['loop']} {r['size']:,} {r['spread']:.2f}" for r in rows if "spread" in r]
-    out.append("Each figure is the median of 5 timed blocks (blastfrac: 5 consecutive blocks of the steps given; the C++ "
-               "program and the port: 5 runs from the same start); blastfrac's slowest block over its fastest: "
-               + ", ".join(spread) + ".")
+    out.append(f"Interleaved: each of {rows[0]['rounds']} rounds runs one repetition of the C++ program, a block of "
+               "blastfrac's steps and one repetition of the port, and gives its own ratios (run_reference).")
     for loop, unit in (("CDEM", "element"), ("MPM", "particle")):
         fulls = [r for r in rows if r["loop"] == loop]
         ports = [r for r in rows if r["loop"].startswith(f"{loop}, the reference")]
         for full, port in zip(fulls, ports):
-            algo = port["blastfrac_per_s"] / full["blastfrac_per_s"]
-            out.append(f"{loop} ({full['size']:,}) per {unit}-step: blastfrac ÷ C++ {full['ratio_time_per_unit']:.2f} = "
-                       f"blastfrac's algorithm ÷ the reference's, both in Warp, {algo:.2f} × Warp ÷ g++ on one algorithm "
-                       f"{port['ratio_time_per_unit']:.2f} (the port's end state matches the C++ run's checks to "
-                       f"{port['reference']['checks_max_rel_diff']:.1e}, relative)")
+            out.append(f"{loop} ({full['size']:,}) per {unit}-step: blastfrac ÷ C++ {full['ratio_time_per_unit']:.2f}; "
+                       f"blastfrac's algorithm ÷ the reference's, both in Warp, {full['algorithm_ratio']:.2f}; "
+                       f"Warp ÷ g++ on one algorithm {port['ratio_time_per_unit']:.2f} (the port's state after one "
+                       f"repetition matches the C++ run's checks to {port['reference']['checks_max_rel_diff']:.1e}, "
+                       "relative)")
     return "\n".join(out)

@@ -29,29 +29,39 @@ def _solver(n_particles: int, device: str):
     return MPMSolver(cfg, device=device)
 
 
+def timer(n_particles: int, device: str = "cpu"):
+    """(info, block): the benchmark's charge of about ``n_particles`` points, one step run (kernel load);
+    ``block(steps)`` runs that many more steps and returns their wall time [s], the device synchronised."""
+    import warp as wp
+
+    s = _solver(n_particles, device)
+    dt = s.stable_dt()
+    s.step(dt, 0.0)  # warm-up (kernel load)
+    wp.synchronize_device(s.device)
+    t = [dt]
+
+    def block(steps: int) -> float:
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            s.step(dt, t[0])
+            t[0] += dt
+        wp.synchronize_device(s.device)
+        return time.perf_counter() - t0
+
+    return {"n_particles": s.n, "units": s.n}, block
+
+
 def run(sizes=(100_000, 400_000, 1_600_000), steps: int = 20, device: str = "cpu", reps: int = 5) -> list[dict]:
     """Time ``reps`` consecutive blocks of ``steps`` steps per size and keep the median block (as the compiled
     reference times itself); returns dicts n_particles, steps, wall_s (the median block), reps, spread (slowest
     block over the fastest), particle_steps_per_s."""
-    import warp as wp
-
     out = []
     for n in sizes:
-        s = _solver(n, device)
-        dt = s.stable_dt()
-        s.step(dt, 0.0)  # warm-up (kernel load)
-        wp.synchronize_device(s.device)
-        walls, t = [], dt
-        for _ in range(max(1, reps)):
-            t0 = time.perf_counter()
-            for _ in range(steps):
-                s.step(dt, t)
-                t += dt
-            wp.synchronize_device(s.device)
-            walls.append(time.perf_counter() - t0)
+        info, block = timer(n, device)
+        walls = [block(steps) for _ in range(max(1, reps))]
         wall = float(np.median(walls))
-        out.append({"n_particles": s.n, "steps": steps, "wall_s": wall, "reps": len(walls),
-                    "spread": max(walls) / min(walls), "particle_steps_per_s": s.n * steps / wall})
+        out.append({"n_particles": info["n_particles"], "steps": steps, "wall_s": wall, "reps": len(walls),
+                    "spread": max(walls) / min(walls), "particle_steps_per_s": info["n_particles"] * steps / wall})
     return out
 
 

@@ -382,6 +382,50 @@ def _side_by_side(ref_dir: Path, cpp_args: list[str], scatter: str, make_port, s
     return cpp, out, step_s, p
 
 
+def _common(ref_dir: Path):
+    """The reference folder's ``common`` module (constants and initial states, numpy only)."""
+    sys.path.insert(0, str(ref_dir))
+    try:
+        import common
+    finally:
+        sys.path.pop(0)
+    return common
+
+
+def cpp_once(ref_dir: Path, cpp_args: list[str], scatter: str) -> dict:
+    """One timed repetition of the built C++ f64 reference (``REPS=1``, one thread): its RESULT."""
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": scatter, "REPS": "1"}
+    r = subprocess.run(["./bench_cpp_f64", *cpp_args], cwd=ref_dir, env=env, capture_output=True, text=True,
+                       check=True)
+    return json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
+
+
+def port_timer(ref_dir: Path, kind: str, n: int = 0, device: str = "cpu"):
+    """(info, block, checks) of the Warp port of the reference's ``kind`` problem ('cdem', or 'mpm' with n points):
+    ``block(steps)`` resets it and times that many steps [s] as the C++ program times a repetition; ``checks()``
+    its state's checks (after a block, comparable with the C++ run's after its first repetition)."""
+    from blastfrac._warp import init_warp
+
+    init_warp()
+    common = _common(ref_dir)
+    p = Port(common, device) if kind == "cdem" else MPMPort(common, n, device)
+    p.reset()
+    p.step()                                   # load the module (kernel compile or cache read)
+    wp.synchronize_device(device)
+
+    def block(steps: int) -> float:
+        p.reset()
+        wp.synchronize_device(device)
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            p.step()
+        wp.synchronize_device(device)
+        return time.perf_counter() - t0
+
+    units = p.ntri if kind == "cdem" else n
+    return {"units": units}, block, p.checks
+
+
 def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> dict:
     """Time the CDEM port as the C++ program times itself (reset, ``steps`` steps, median over ``reps``) and check
     its state after the first repetition against the built C++ f64 reference of ``ref_dir`` run on one thread.
