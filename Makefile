@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 DEMO   := examples/circular_rock/demo.toml
 
-.PHONY: demo test validate bench gpu-check clean
+.PHONY: demo test validate bench gpu-check gpu-pack clean
 
 $(VENV)/.installed: pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -44,6 +44,10 @@ bench: $(VENV)/.installed
 ## gpu-check: on a machine with a CUDA GPU, its throughput and run times and their agreement with the CPU (out/gpu_check)
 gpu-check: $(VENV)/.installed
 	$(BIN)/python benchmarks/gpu_check.py
+
+## gpu-pack: for a lent GPU machine without Warp: the dependencies in parts of a call's size (.gpu/pK; benchmarks/gpu_pack.py)
+gpu-pack: $(VENV)/.installed
+	$(BIN)/python benchmarks/gpu_pack.py
 
 clean:
 	rm -rf out .pytest_cache

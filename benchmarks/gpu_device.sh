@@ -10,6 +10,8 @@ if [ ! -d "$SITE/warp" ]; then
     python3 benchmarks/gpu_pack.py --unpack "$SITE"
 fi
 export PYTHONPATH="$SITE:$PWD/src"
+# the pack's kernel cache: blastfrac's modules compiled for sm_90 at packing time (gpu_pack.cuda_cache)
+export WARP_CACHE_PATH="$SITE/warp_cache"
 nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv,noheader || true
 python3 -c "import warp as wp; wp.init(); print('warp', wp.__version__, [d.name for d in wp.get_cuda_devices()])"
 python3 benchmarks/gpu_check.py --device cuda:0 --skip-cpu --out "${OUT:-out/gpu_check}" "$@"
