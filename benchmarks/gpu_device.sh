@@ -10,6 +10,17 @@ if [ ! -d "$SITE/warp" ]; then
     python3 benchmarks/gpu_pack.py --unpack "$SITE"
 fi
 export PYTHONPATH="$SITE:$PWD/src"
+# the libraries libgmsh.so links against that this machine lacks, from the pack (gpu_pack.bundle_system_libraries):
+# only those, so that none of the image's own is shadowed
+mkdir -p "$SITE/syslibs_used"
+known=$(ldconfig -p)
+for f in "$SITE"/syslibs/*; do
+    n=$(basename "$f")
+    grep -q "^[[:space:]]*$n " <<<"$known" || ln -sf "$f" "$SITE/syslibs_used/$n"
+done
+echo "bundled libraries used: $(ls "$SITE/syslibs_used" | tr '\n' ' ')"
+export LD_LIBRARY_PATH="$SITE/syslibs_used${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+python3 -c "import gmsh; gmsh.initialize(); gmsh.finalize(); print('gmsh', gmsh.__version__)"
 # the pack's kernel cache: blastfrac's modules compiled for sm_90 at packing time (gpu_pack.cuda_cache)
 export WARP_CACHE_PATH="$SITE/warp_cache"
 nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv,noheader || true

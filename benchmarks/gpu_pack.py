@@ -64,6 +64,30 @@ def cuda_cache(cache: Path) -> None:
                    capture_output=True)
 
 
+#: where the pack keeps the shared libraries libgmsh.so links against (gpu_device.sh puts those the device lacks on
+#: LD_LIBRARY_PATH)
+SYSLIBS = "syslibs"
+#: the C and C++ run-time libraries every Linux has: not bundled (the device's own must be used)
+RUNTIME = ("libc.so", "libm.so", "libpthread.so", "libdl.so", "librt.so", "ld-linux", "libstdc++.so", "libgcc_s.so",
+           "linux-vdso")
+
+
+def bundle_system_libraries(stage: Path) -> list[str]:
+    """Copy into stage/SYSLIBS the shared libraries libgmsh.so needs (X11, GL, fontconfig… as this machine resolves
+    them, ``ldd``), the C/C++ run time excepted: the lent machines' image is made for CUDA, not for a desktop, and
+    may lack them. Built on an older glibc than the device's (Debian 12 here: 2.36), so they load there."""
+    lib = next((stage / "lib").glob("libgmsh.so*"))
+    out = subprocess.run(["ldd", str(lib)], capture_output=True, text=True, check=True).stdout
+    (stage / SYSLIBS).mkdir(exist_ok=True)
+    names = []
+    for line in out.splitlines():
+        f = line.split()
+        if len(f) >= 3 and f[1] == "=>" and f[2].startswith("/") and not any(r in f[0] for r in RUNTIME):
+            shutil.copy2(os.path.realpath(f[2]), stage / SYSLIBS / f[0])
+            names.append(f[0])
+    return names
+
+
 def installed_versions() -> dict[str, str]:
     """The installed version of each NEEDED distribution (this machine's environment is the tested one)."""
     from importlib.metadata import version
@@ -97,6 +121,7 @@ def build(python_version: str, part_mib: int, out: Path = PACK) -> list[Path]:
         for rel in DROP:
             shutil.rmtree(stage / rel, ignore_errors=True)
         cuda_cache(stage / CACHE)
+        bundle_system_libraries(stage)
         blob = Path(tmp) / "site.tar.xz"
         # xz from the command line uses both cores (Python's lzma one); -6: -9 saved 4 % of Warp's library for 2x
         with open(blob, "wb") as f:
@@ -168,7 +193,16 @@ def check(python_version: str, part_mib: int) -> None:
                 "print('pack ok: warp', wp.__version__, 'gmsh', gmsh.__version__, 'from', sys.argv[1])")
         script = out / "check_pack.py"
         script.write_text(code)
-        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(out / "site"), str(ROOT / "src")])}
+        # every bundled library on the path (the device puts only those it lacks there): they must serve libgmsh
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(out / "site"), str(ROOT / "src")]),
+               "LD_LIBRARY_PATH": str(out / "site" / SYSLIBS)}
+        lib = next((out / "site" / "lib").glob("libgmsh.so*"))
+        resolved = subprocess.run(["ldd", str(lib)], env=env, capture_output=True, text=True, check=True).stdout
+        bundled = {p.name for p in (out / "site" / SYSLIBS).iterdir()}
+        wrong = [ln.split()[0] for ln in resolved.splitlines()
+                 if ln.split() and ln.split()[0] in bundled and str(out / "site" / SYSLIBS) not in ln]
+        assert bundled and not wrong, (sorted(bundled), wrong)
+        print(f"libgmsh's {len(bundled)} bundled libraries resolve from the pack")
         subprocess.run([sys.executable, str(script), str(out / "site")], env=env, check=True)
         subprocess.run([sys.executable, "-m", "blastfrac", "run", str(ROOT / "examples/circular_rock/demo.toml"),
                         "--set", "simulation.end_time=2e-7", "--set", "output.paraview=false",
