@@ -339,47 +339,28 @@ class Port:
                                        self.sigma.numpy())
 
 
-def _side_by_side(ref_dir: Path, cpp_args: list[str], scatter: str, make_port, steps: int | None, reps: int,
-                  device: str) -> tuple[dict, dict, float]:
-    """Run the built C++ f64 reference of ``ref_dir`` (``./bench_cpp_f64 *cpp_args``, one thread) and time the Warp
-    port ``make_port(common)`` as the C++ program times itself: reset, ``steps`` steps (the C++ run's own count by
-    default), median over ``reps``; its checks after the first repetition against the C++ run's. Returns (the C++
-    RESULT, the port's fields of the result without its size, the port's seconds a step, the port)."""
-    from blastfrac._warp import init_warp
-
-    init_warp()
-    sys.path.insert(0, str(ref_dir))
-    try:
-        import common
-    finally:
-        sys.path.pop(0)
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": scatter, "REPS": str(reps)}
-    r = subprocess.run(["./bench_cpp_f64", *cpp_args], cwd=ref_dir, env=env, capture_output=True, text=True,
-                       check=True)
-    cpp = json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
+def _side_by_side(ref_dir: Path, cpp_args: list[str], scatter: str, kind: str, n: int, steps: int | None, reps: int,
+                  device: str) -> tuple[dict, dict, float, dict]:
+    """Run the built C++ f64 reference of ``ref_dir`` (``./bench_cpp_f64 *cpp_args``, one thread, ``reps``
+    repetitions) and time the Warp port of the same problem (``port_timer``) as the C++ program times itself: reset,
+    ``steps`` steps (the C++ run's own count by default), median over ``reps``; its checks after the first
+    repetition against the C++ run's. Returns (the C++ RESULT, the port's fields of the result without its size,
+    the port's seconds a step, the port's info)."""
+    cpp = run_cpp(ref_dir, cpp_args, scatter, reps)
     steps = int(cpp["nsteps"]) if steps is None else steps
-    p = make_port(common)
-    p.reset()
-    p.step()                                   # load the module (kernel compile or cache read)
-    wp.synchronize_device(device)
+    info, block, checks = port_timer(ref_dir, kind, n, device)
     walls, chk = [], None
     for k in range(reps):
-        p.reset()
-        wp.synchronize_device(device)
-        t0 = time.perf_counter()
-        for _ in range(steps):
-            p.step()
-        wp.synchronize_device(device)
-        walls.append(time.perf_counter() - t0)
+        walls.append(block(steps))
         if k == 0:
-            chk = p.checks()
+            chk = checks()
     step_s = float(np.median(walls)) / steps
     ref = cpp["checks"]
     rel = {k: abs(chk[k] - ref[k]) / max(abs(ref[k]), 1e-300) for k in chk}
     out = {"port_step_ms": 1e3 * step_s, "cpp_step_ms": cpp["step_ms_median"],
            "cpp_units_steps_per_s": cpp["units_steps_per_s"], "port_over_cpp": step_s * 1e3 / cpp["step_ms_median"],
            "checks": chk, "cpp_checks": ref, "checks_max_rel_diff": max(rel.values()), "device": device}
-    return cpp, out, step_s, p
+    return cpp, out, step_s, info
 
 
 def _common(ref_dir: Path):
@@ -392,12 +373,18 @@ def _common(ref_dir: Path):
     return common
 
 
-def cpp_once(ref_dir: Path, cpp_args: list[str], scatter: str) -> dict:
-    """One timed repetition of the built C++ f64 reference (``REPS=1``, one thread): its RESULT."""
-    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": scatter, "REPS": "1"}
+def run_cpp(ref_dir: Path, cpp_args: list[str], scatter: str, reps: int = 1) -> dict:
+    """The built C++ f64 reference (``./bench_cpp_f64 *cpp_args``, one thread, ``reps`` timed repetitions, their
+    median its figure): its RESULT."""
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "SCATTER": scatter, "REPS": str(reps)}
     r = subprocess.run(["./bench_cpp_f64", *cpp_args], cwd=ref_dir, env=env, capture_output=True, text=True,
                        check=True)
     return json.loads(next(line for line in r.stdout.splitlines() if line.startswith("RESULT")).split(" ", 1)[1])
+
+
+def cpp_once(ref_dir: Path, cpp_args: list[str], scatter: str) -> dict:
+    """One timed repetition of the built C++ f64 reference (one thread): its RESULT."""
+    return run_cpp(ref_dir, cpp_args, scatter, 1)
 
 
 def port_timer(ref_dir: Path, kind: str, n: int = 0, device: str = "cpu"):
@@ -430,15 +417,14 @@ def run(ref_dir: Path, steps: int = 50, reps: int = 5, device: str = "cpu") -> d
     """Time the CDEM port as the C++ program times itself (reset, ``steps`` steps, median over ``reps``) and check
     its state after the first repetition against the built C++ f64 reference of ``ref_dir`` run on one thread.
     Returns both RESULTs, the port's checks and the largest relative difference of the checks."""
-    _, out, step_s, port = _side_by_side(ref_dir, ["cdem"], "colour", lambda c: Port(c, device), steps, reps, device)
-    return {"triangles": port.ntri, "port_units_steps_per_s": port.ntri / step_s, **out}
+    _, out, step_s, info = _side_by_side(ref_dir, ["cdem"], "colour", "cdem", 0, steps, reps, device)
+    return {"triangles": info["units"], "port_units_steps_per_s": info["units"] / step_s, **out}
 
 
 def run_mpm(ref_dir: Path, n: int = 100_000, reps: int = 5, device: str = "cpu") -> dict:
     """The MPM port timed as the C++ program times its ``mpm n`` (reset, its 20 steps, median over ``reps``), its
     state after the first repetition checked against the C++ f64 run's (one thread, SCATTER=private)."""
-    _, out, step_s, _ = _side_by_side(ref_dir, ["mpm", str(n)], "private", lambda c: MPMPort(c, n, device), None,
-                                      reps, device)
+    _, out, step_s, _ = _side_by_side(ref_dir, ["mpm", str(n)], "private", "mpm", n, None, reps, device)
     return {"particles": n, "port_units_steps_per_s": n / step_s, **out}
 
 
