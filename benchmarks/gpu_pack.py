@@ -4,21 +4,25 @@ The lent machines (``../.library/device``: H100 / H200, Python 3.12, no network)
 rich, but not Warp, gmsh, pydantic, meshio or tomli-w, and a call carries at most 64 MiB, the working tree
 included (~21 MB). Warp's wheel alone is 149 MB (its CUDA library, 299 MB unpacked). So:
 
-1. here, at no device time: ``python benchmarks/gpu_pack.py`` downloads the wheels of the versions installed here
-   for CPython 3.12 on manylinux x86-64, installs them into a staging folder, drops what a run does not read
-   (Warp's examples, gmsh's docs and headers), and writes it as one xz-compressed tar split into parts of at most
-   ``--part-mib`` MiB, ``.gpu/p1`` … ``.gpu/pN`` (``.gpu/`` is in .gitignore; ~3 minutes on 2 cores);
+1. here, at no device time: ``python benchmarks/gpu_pack.py`` (``make gpu-pack``) downloads the wheels of the
+   versions installed here for CPython 3.12 on manylinux x86-64 and installs them into a staging folder, with the
+   shared libraries libgmsh.so links against (``bundle_system_libraries``) and a Warp kernel cache of every blastfrac
+   module compiled for sm_90 (``cuda_cache``); it drops what a run does not read (Warp's examples, gmsh's docs and
+   headers) and writes the folder as one xz-compressed tar split into parts that each fit a call beside the working
+   tree, ``.gpu/p1`` … ``.gpu/pN`` (``.gpu/`` is in .gitignore; 3 parts and ~4 minutes on 2 cores);
 2. on the device, one call per part while the machine stays warm (it keeps ignored paths between calls; it is given
    back after 30 s idle): ``run(command="true", carry=[".gpu/p1"])``, … and the last part with the work itself:
    ``run(command="bash benchmarks/gpu_device.sh", carry=[".gpu/pN"], timeout_s=...)``;
 3. ``gpu_device.sh`` calls ``python3 benchmarks/gpu_pack.py --unpack /tmp/site`` (standard library only: it joins
-   the parts in order and checks the total size and SHA-256 written beside them), sets PYTHONPATH and runs
-   ``gpu_check.py --skip-cpu``; the CPU side of the agreement check then runs here
-   (``python benchmarks/gpu_check.py --compare DIR``), at no device time.
+   the parts in order and checks the total size and SHA-256 written beside them), sets PYTHONPATH, LD_LIBRARY_PATH
+   (the bundled libraries the machine lacks) and WARP_CACHE_PATH, and runs ``gpu_check.py --skip-cpu``; fetch its
+   ``gpu_check.json`` and run the CPU side of the agreement check here
+   (``python benchmarks/gpu_check.py --compare gpu_check.json``), at no device time.
 
 ``python benchmarks/gpu_pack.py --python-version 3.11 --check`` builds a pack for this machine's Python, unpacks it
-into a scratch folder and imports Warp, gmsh, pydantic, meshio and tomli-w from there, and runs one Warp kernel on
-the CPU: the round trip that the device depends on, tried at no device time.
+into a scratch folder, imports Warp, gmsh, pydantic, meshio and tomli-w from there with every bundled library on
+LD_LIBRARY_PATH (``ldd`` must resolve them there) and runs the demo for 0.2 µs: the round trip the device depends
+on, tried at no device time.
 """
 
 from __future__ import annotations
@@ -57,11 +61,10 @@ def cuda_cache(cache: Path) -> None:
     """Compile every blastfrac kernel module for ARCH into the kernel cache ``cache`` (Warp's own layout, by this
     machine's Warp, which is the packed version): a module's name and hash are those the device computes for the
     same source, so it finds them; a miss only costs the compile."""
-    code = ("import sys; sys.path.insert(0, sys.argv[1]); import test_cuda_compile as t, warp as wp\n"
-            "[wp.compile_aot_module(n, arch=int(sys.argv[2])) for n in t.MODULES]")
+    code = ("import sys, warp as wp; from blastfrac._warp import kernel_module_names\n"
+            "[wp.compile_aot_module(n, arch=int(sys.argv[1])) for n in kernel_module_names()]")
     env = {**os.environ, "WARP_CACHE_PATH": str(cache)}
-    subprocess.run([sys.executable, "-c", code, str(ROOT / "tests" / "unit"), str(ARCH)], env=env, check=True,
-                   capture_output=True)
+    subprocess.run([sys.executable, "-c", code, str(ARCH)], env=env, check=True, capture_output=True)
 
 
 #: where the pack keeps the shared libraries libgmsh.so links against (gpu_device.sh puts those the device lacks on

@@ -41,6 +41,23 @@ def init_warp() -> None:
         os.close(saved)
 
 
+def kernel_module_names() -> list[str]:
+    """Names of blastfrac's Warp modules that hold kernels, after importing every submodule (what a GPU compiles:
+    tests/unit/test_cuda_compile.py, benchmarks/gpu_pack.py)."""
+    import importlib
+    import pkgutil
+
+    from warp._src.context import user_modules
+
+    import blastfrac
+
+    init_warp()
+    for info in pkgutil.walk_packages(blastfrac.__path__, "blastfrac."):
+        if not info.name.endswith("__main__"):
+            importlib.import_module(info.name)
+    return sorted(name for name, m in user_modules.items() if name.startswith("blastfrac.") and m.kernels)
+
+
 def resolve_device(name: str | None) -> str:
     """Return a Warp device string for ``name`` ("cpu", "cuda", "cuda:0", None → cpu).
 

@@ -9,14 +9,10 @@ during the minutes on the device. This checks that the kernels compile; whether 
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
-
 import pytest
 import warp as wp
 
-import blastfrac
-from blastfrac._warp import init_warp
+from blastfrac._warp import init_warp, kernel_module_names
 
 #: the target architecture: H100 / H200 (compute capability 9.0)
 ARCH = 90
@@ -25,17 +21,6 @@ ARCH = 90
 CORE = {"blastfrac.cdem.kernels_spring", "blastfrac.cdem.kernels_element", "blastfrac.cdem.kernels_integrate",
         "blastfrac.cdem.contact_kernels", "blastfrac.coupling.kernels_contact", "blastfrac.mpm.kernels_p2g",
         "blastfrac.mpm.kernels_g2p", "blastfrac.mpm.kernels_eos"}
-
-
-def kernel_modules() -> list[str]:
-    """Names of the Warp modules of blastfrac that hold kernels, after importing every submodule."""
-    init_warp()
-    for info in pkgutil.walk_packages(blastfrac.__path__, "blastfrac."):
-        if not info.name.endswith("__main__"):
-            importlib.import_module(info.name)
-    from warp._src.context import user_modules
-
-    return sorted(name for name, m in user_modules.items() if name.startswith("blastfrac.") and m.kernels)
 
 
 def _cuda_compiler() -> bool:
@@ -48,7 +33,7 @@ def _cuda_compiler() -> bool:
     return bool(getattr(runtime, "is_cuda_enabled", False))
 
 
-MODULES = kernel_modules()
+MODULES = kernel_module_names()
 
 
 def test_discovery_finds_the_step_kernels():
