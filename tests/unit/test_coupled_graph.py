@@ -166,3 +166,50 @@ def test_a_failed_capture_falls_back_to_the_launches(tmp_path, monkeypatch, wher
     a, b = _state(ref), _state(cap)
     for name in a:
         assert np.array_equal(a[name], b[name]), name
+
+
+def test_nothing_is_read_back_or_allocated_inside_a_capture(tmp_path, monkeypatch):
+    """What a CUDA stream capture refuses, refused here on the CPU: inside the capture of a coupled step no array is
+    read to the host (``numpy``, ``list``), nothing synchronises, and nothing is allocated or uploaded from host data
+    (views of existing arrays are fine). A CPU capture would record such a step without complaint, and the
+    bit-identity above only catches the reads whose values change what the step does; on a GPU each of them fails
+    the capture (the run then falls back to the launches, issue 14 item 1). Crack gas on, so that every captured
+    stage takes part."""
+    import warp as wp
+
+    import blastfrac.coupled_graph as coupled_graph
+
+    inside, seen = [False], []
+
+    def guard(owner, name, allowed=lambda *a, **k: False):
+        real = getattr(owner, name)
+
+        def checked(*a, **k):
+            if inside[0] and not allowed(*a, **k):
+                seen.append(name)
+                raise RuntimeError(f"{name} inside a captured step")
+            return real(*a, **k)
+        monkeypatch.setattr(owner, name, checked)
+
+    for name in ("numpy", "list"):
+        guard(wp.array, name)
+    # a view (ptr given, no host data) is not an allocation
+    guard(wp.array, "__init__", allowed=lambda self, data=None, *a, **k: data is None and k.get("ptr") is not None)
+    for name in ("synchronize", "synchronize_device", "synchronize_stream", "empty", "zeros", "full", "clone",
+                 "empty_like", "zeros_like", "full_like", "from_numpy"):
+        guard(wp, name)
+    real_capture = coupled_graph.CoupledGraphs._capture
+
+    def capture(self, sim, dt):
+        inside[0] = True
+        try:
+            return real_capture(self, sim, dt)
+        finally:
+            inside[0] = False
+    monkeypatch.setattr(coupled_graph.CoupledGraphs, "_capture", capture)
+    sim = Simulation(scenario_from_dict(_scenario("on", crack_gas=True)), out_dir=tmp_path)
+    for _ in range(500):
+        sim.step()
+    assert not seen and not sim.warnings, (seen, sim.warnings)
+    assert sim.coupled_graph and sim.coupled_graph_captures > 4 and sim.coupled_graph_steps > 200
+    assert sim.crack_gas.gas.mass.numpy().sum() > 0          # the captured stages carried gas into the cracks
