@@ -262,7 +262,7 @@ class GasRockCoupler:
         """The host's side of a step (``apply`` calls it; a replayed step, Simulation, calls it alone): the rebuild
         schedule, the step lengths of the work books, and the contact histories' buffers, read from one pair and
         written to the other. Returns (rebuild now, w_old = ½Δt of the last step [s], histories in, out)."""
-        rebuild = self._since >= self.rebuild_interval
+        rebuild = self.rebuild_due()
         self._since = 1 if rebuild else self._since + 1
         w_old = 0.5 * self._dt_work                       # the last step's forces, velocities after that step
         self._dt_work = dt
@@ -271,10 +271,14 @@ class GasRockCoupler:
         self._hist = [h_out, h_in]                        # this step's histories are the next step's input
         return rebuild, w_old, h_in, h_out
 
+    def rebuild_due(self) -> bool:
+        """True when this step rebuilds the list and its hashes (every ``rebuild_interval`` steps)."""
+        return self._since >= self.rebuild_interval
+
     def graph_key(self) -> tuple:
         """What a captured step holds fixed of this stage from step to step (a graph for each, coupled_graph.py):
         whether it rebuilds the list, the buffer its histories come from, the last step's length."""
-        return self._since >= self.rebuild_interval, id(self._hist[0][0]), self._dt_work
+        return self.rebuild_due(), id(self._hist[0][0]), self._dt_work
 
     def graph_held(self) -> tuple:
         """What it holds fixed for longer (every graph is captured again when it changes): the MPM box the list
