@@ -32,7 +32,10 @@ class CDEMSolver:
     def __init__(self, model: Model, block_contact: bool | None = None):
         self.model = model
         n = max(1, len(model.pulses))
-        self._pulse_host = wp.zeros(n, dtype=wp.float64, device="cpu", pinned=model.device != "cpu")
+        # pageable, not pinned: a copy from pageable memory to a GPU is staged before wp.copy returns, so the next
+        # step may rewrite the buffer; from pinned memory the copy would read it when the stream gets there, after
+        # the host had written a later step's values (the launches do not wait for the GPU between steps)
+        self._pulse_host = wp.zeros(n, dtype=wp.float64, device="cpu")
         use_contact = model.breakable == 1 if block_contact is None else block_contact
         self.contact = BlockContact(model) if use_contact else None
         self.dt_prev = 0.0
