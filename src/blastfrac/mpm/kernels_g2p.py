@@ -170,7 +170,8 @@ def update_particle_kinematics(
 ):
     """L_p = sum v_I (x) grad N_I (remapped v_I); V_p *= det(I + dt L); rho = m/V; x_p += dt v_pic.
 
-    A particle whose stencil leaves a non-periodic grid is deactivated (active = 0) and counted.  The
+    A particle whose stencil leaves a non-periodic grid, or whose position or volume is no longer finite, is
+    deactivated (active = 0) and counted.  The
     stencil base cell at the new position widens ``extent`` (min i, min j, max i, max j), from which the
     grid's active box is renewed (:mod:`blastfrac.mpm.grid`).
     """
@@ -200,16 +201,22 @@ def update_particle_kinematics(
         fy = fy - wp.floor(fy / wp.float64(geo.ny)) * wp.float64(geo.ny)
         xn[1] = geo.y0 + fy / geo.inv_h
     x[p] = xn
+    # the stencil's base cell floor(f - 1/2) must lie in [0, n - 3], tested in floating point: a blown-up particle
+    # (a NaN or huge coordinate) converts to INT_MIN on a CPU but saturates on a GPU (NaN to 0, +huge to INT_MAX,
+    # whose base + 2 wraps negative), where it would stay active and scatter out of the grid; a NaN coordinate or
+    # volume fails every comparison, so each test is written to be true only for a valid particle
+    zx = fx - F64(0.5)
+    zy = fy - F64(0.5)
     out = 0
+    if not (wp.isfinite(zx) and wp.isfinite(zy)):
+        out = 1
     if geo.px == 0:
-        b = int(wp.floor(fx - F64(0.5)))
-        if b < 0 or b + 2 > geo.nx - 1:
+        if not (zx >= F64(0.0) and zx < wp.float64(geo.nx - 2)):
             out = 1
     if geo.py == 0:
-        b = int(wp.floor(fy - F64(0.5)))
-        if b < 0 or b + 2 > geo.ny - 1:
+        if not (zy >= F64(0.0) and zy < wp.float64(geo.ny - 2)):
             out = 1
-    if out != 0 or J <= F64(0.0):
+    if out != 0 or not (J > F64(0.0)):
         active[p] = 0
         wp.atomic_add(deactivated, 0, 1)
         return
