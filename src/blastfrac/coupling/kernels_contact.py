@@ -181,6 +181,8 @@ def eval_particle_edge_contact(
     if active[p] == 0:
         f_p[p] = fsum
         fm_p[p] = msum
+        if heat > zero:
+            diss_p[p] = zero          # a point that left the grid holds no share of the contacts' heat
         return
     xp = x_p[p]
     vp = v_p[p]
