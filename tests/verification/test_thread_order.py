@@ -8,9 +8,11 @@ rewritten before anything compiles, in a kernel cache of its own). Without an or
 by the round-off of sums made in the other order: no spring breaks or drops differently, no crack cell wets
 differently, and no float array moves by more than round-off over the steps.
 
-The child first runs a kernel whose threads do read their neighbour's write, to show that the reversal took effect.
-Launches that a CPU runs as one thread over a list (block contact's passes, CDEM's one-thread bookkeeping) are not
-reordered by this; the audit of 2026-12-07 (CHANGELOG) read those.
+Block contact runs in the form a GPU runs (``BlockContact._cpu = False``: one thread per listed node or vertex, its
+lists filled by atomic appends), which a CPU otherwise runs as one thread over each list in node order; run in order
+on a CPU the two forms give the same bits. The child first runs a kernel whose threads do read their neighbour's
+write, to show that the reversal took effect. A spring or cell that sits on a threshold could in principle flip
+under round-off; none does in these steps.
 """
 
 import subprocess
@@ -77,6 +79,7 @@ def run_from(checkpoint_dir: str, out_dir: str) -> dict:
 
     shutil.copytree(checkpoint_dir, out_dir)
     sim = Simulation(scenario_from_dict(_scenario()), out_dir=out_dir, max_steps=START + STEPS)
+    sim.cdem.contact._cpu = False          # block contact's GPU form: one thread per listed item, lists by atomics
     sim.run(progress=False, restart=Path(out_dir) / CHECKPOINT_NAME)
     assert sim.steps == START + STEPS
     return _state(sim)
