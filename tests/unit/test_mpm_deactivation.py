@@ -37,7 +37,8 @@ def test_leaving_or_blown_up_particles_are_deactivated_and_counted():
     x0 = s.x.numpy().copy()
     v = np.zeros((n, 2))
     # one step of dt moves a particle by v·dt: to the first valid base cell (f = 1/2 exactly) and past the last
-    # one (f = nx − 3/2), by a NaN, by a huge value, along the periodic y axis by NaN, and by a finite y jump
+    # one (f = nx − 3/2), by a NaN, by a huge value, along the periodic y axis by NaN, by a finite jump and by
+    # a huge one
     fx = (x0[:, 0] - spec.x0) / h
     k_lo, k_hi = int(np.argmin(fx)), int(np.argmax(fx))
     v[k_lo, 0] = (0.5 - fx[k_lo]) * h / dt             # lands on f = 1/2: still inside
@@ -46,8 +47,9 @@ def test_leaving_or_blown_up_particles_are_deactivated_and_counted():
     v[5] = (1e300, 0.0)
     v[7] = (0.0, np.nan)
     v[9] = (0.0, 3.7 * h / dt)                         # wraps around the periodic axis: inside
+    v[11] = (0.0, 1e300)                               # wraps to a huge remainder: out
     active, count = _kinematics(s, v, dt)
-    out = {k_hi, 3, 5, 7}
+    out = {k_hi, 3, 5, 7, 11}
     assert count == len(out)
     assert sorted(np.flatnonzero(active == 0)) == sorted(out)
     xs = s.x.numpy()

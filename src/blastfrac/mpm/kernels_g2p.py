@@ -171,9 +171,8 @@ def update_particle_kinematics(
     """L_p = sum v_I (x) grad N_I (remapped v_I); V_p *= det(I + dt L); rho = m/V; x_p += dt v_pic.
 
     A particle whose stencil leaves a non-periodic grid, or whose position or volume is no longer finite, is
-    deactivated (active = 0) and counted.  The
-    stencil base cell at the new position widens ``extent`` (min i, min j, max i, max j), from which the
-    grid's active box is renewed (:mod:`blastfrac.mpm.grid`).
+    deactivated (active = 0) and counted.  The stencil base cell at the new position widens ``extent`` (min i,
+    min j, max i, max j), from which the grid's active box is renewed (:mod:`blastfrac.mpm.grid`).
     """
     p = wp.tid()
     if active[p] == 0:
@@ -194,6 +193,14 @@ def update_particle_kinematics(
     xn = x[p] + dt * v_pic[p]
     fx = (xn[0] - geo.x0) * geo.inv_h
     fy = (xn[1] - geo.y0) * geo.inv_h
+    # Whether the particle is still on the grid, tested in floating point: a blown-up particle (a NaN or huge
+    # coordinate) converts to INT_MIN on a CPU but saturates on a GPU (NaN to 0, +huge to INT_MAX, whose base + 2
+    # wraps negative), where it would stay active and scatter out of the grid. A NaN fails every comparison, so
+    # each test is true only for a valid particle. First a bound on the coordinates before a periodic axis wraps
+    # them (the wrap of a huge one is anything, 0 included); no grid has 1e9 cells along an axis.
+    out = 0
+    if not (wp.abs(fx) < F64(1.0e9) and wp.abs(fy) < F64(1.0e9)):
+        out = 1
     if geo.px != 0:
         fx = fx - wp.floor(fx / wp.float64(geo.nx)) * wp.float64(geo.nx)
         xn[0] = geo.x0 + fx / geo.inv_h
@@ -201,15 +208,9 @@ def update_particle_kinematics(
         fy = fy - wp.floor(fy / wp.float64(geo.ny)) * wp.float64(geo.ny)
         xn[1] = geo.y0 + fy / geo.inv_h
     x[p] = xn
-    # the stencil's base cell floor(f - 1/2) must lie in [0, n - 3], tested in floating point: a blown-up particle
-    # (a NaN or huge coordinate) converts to INT_MIN on a CPU but saturates on a GPU (NaN to 0, +huge to INT_MAX,
-    # whose base + 2 wraps negative), where it would stay active and scatter out of the grid; a NaN coordinate or
-    # volume fails every comparison, so each test is written to be true only for a valid particle
+    # then, on a non-periodic axis, the stencil's base cell floor(f - 1/2) within [0, n - 3]
     zx = fx - F64(0.5)
     zy = fy - F64(0.5)
-    out = 0
-    if not (wp.isfinite(zx) and wp.isfinite(zy)):
-        out = 1
     if geo.px == 0:
         if not (zx >= F64(0.0) and zx < wp.float64(geo.nx - 2)):
             out = 1
