@@ -16,7 +16,7 @@ def add_parser(sub) -> None:
     p.add_argument("--restart", default=None, metavar="DIR",
                    help="continue the run whose output directory is DIR from its checkpoint.npz (the scenario "
                         "defaults to DIR/resolved.toml; only simulation.end_time, max_steps, progress, device, threads and "
-                        "[output] may differ). Results are bit-identical to a run that went through.")
+                        "[output] may differ). On a CPU the results are bit-identical to a run that went through.")
     add_force_arg(p)
     p.set_defaults(func=run)
 

@@ -50,7 +50,7 @@ class SimulationConfig(_Strict):
     )
     graph: Literal["auto", "on", "off"] = Field(
         "auto", description="Replay steps from a captured graph (a CUDA graph on a GPU, Warp's C++ replay of the "
-        "recorded operations on a CPU), with the same results to the bit as the launches (tests/unit/"
+        "recorded operations on a CPU), with the same results to the bit as the launches on a CPU (tests/unit/"
         "test_rock_graph.py, test_coupled_graph.py): 'auto' replays the rock-only steps everywhere and the coupled "
         "steps on a GPU; 'on' the coupled steps on a CPU too, in one thread (on a CPU the launches, in two threads "
         "where that is faster, cost less: docs/scenario.md, 'Graphs'); 'off' runs every step through the launches. "
@@ -82,7 +82,8 @@ class OutputConfig(_Strict):
     checkpoint_interval: float | None = Field(
         None, gt=0, description="Simulated time between checkpoints [s] (checkpoint.npz in the output directory, "
         "written atomically; the last one is kept); default none. SIGINT/SIGTERM always write one. Continue with "
-        "`blastfrac run --restart DIR` (bit-identical to a run that went through, io/checkpoint.py).",
+        "`blastfrac run --restart DIR` (on a CPU bit-identical to a run that went through, io/checkpoint.py; on a GPU "
+        "atomic sums make no two runs bit-identical).",
     )
     budget_warning: float = Field(
         0.05, gt=0, le=1,
