@@ -20,7 +20,9 @@ writes the agreement, so that no device time goes to CPU runs.
 
 The GPU's atomics add in another order than the CPU's, and fracture amplifies round-off, so the runs are compared by
 these measures, not to the bit. Writes DIR/gpu_check.json and DIR/gpu_check.md (default DIR: $OUT, else
-out/gpu_check) and prints the markdown. ``--quick``: small sizes and short runs, to try the script (on a CPU with
+out/gpu_check) after each part (MPM first, which needs no mesh; then CDEM and each run), so that a call cut off by
+its time limit brings back what it measured, and prints the markdown. A part that fails is recorded in the files
+(``errors``) and the others still run; the exit status is then 1. ``--quick``: small sizes and short runs, to try the script (on a CPU with
 ``--device cpu``). Kernels compile on first use (a minute or two on a fresh machine: the CUDA compile of the
 block-contact kernels alone takes ~50 s through NVRTC).
 """
@@ -34,6 +36,7 @@ import platform
 import sys
 import tempfile
 import time
+import traceback
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -88,9 +91,11 @@ def gpu_pairs(case: str, gpu: list[dict]) -> list[dict]:
 
 def markdown(res: dict) -> str:
     lines = [f"GPU check on {res['device_name']} ({res['device']}), Warp {res['warp']}, {res['date']}", ""]
+    for e in res.get("errors", []):
+        lines += [f"**{e['stage']} failed**: {e['error']}", ""]
     for key, unit in (("cdem", "element-steps/s"), ("mpm", "particle-steps/s")):
         lines += [f"| {key.upper()} size | steps | wall [s] | {unit} |", "|---:|---:|---:|---:|"]
-        for r in res[key]:
+        for r in res.get(key, []):
             n = r.get("elements", r.get("n_particles"))
             rate = r.get("element_steps_per_s", r.get("particle_steps_per_s"))
             lines.append(f"| {n:,} | {r['steps']} | {r['wall_s']:.3f} | {rate:.3e} |")
@@ -102,7 +107,7 @@ def markdown(res: dict) -> str:
         lines.append(f"| {r['case']} | {r['device']} | {r['graph']} | {r['threads']} | {r['steps']} | "
                      f"{r['run_wall_s']:.2f} | {r['D']:.4f} | {r['energy']['budget_error_relative']:.3%} | "
                      f"{g.get('coupled_steps_replayed', 0)} |")
-    lines += ["", "| case | GPU run | D vs CPU ("on vs off": vs the other GPU run) | worst energy term (share of released) | budget error diff | within 2 % / 1 % |",
+    lines += ["", "| case | GPU run | D vs CPU ('on vs off': vs the other GPU run) | worst energy term (share of released) | budget error diff | within 2 % / 1 % |",
               "|---|---|---:|---|---:|---|"]
     for a in res["agreement"]:
         lines.append(f"| {a['case']} | graph {a['graph']} | {a['D_rel']:+.2%} | {a['worst_term']} "
@@ -124,11 +129,8 @@ def compare(gpu_json: Path, out: Path) -> int:
         res["runs"].append(cpu)
         res["agreement"] += [{"case": case, "graph": r["graph"], **agreement(cpu, r)} for r in gpu]
         res["agreement"] += gpu_pairs(case, gpu)
-    text = markdown(res)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "gpu_check.json").write_text(json.dumps(res, indent=1, default=str))
-    (out / "gpu_check.md").write_text(text + "\n")
-    print(text)
+    save(res, out)
+    print(markdown(res))
     return 0 if all(a["ok"] for a in res["agreement"]) else 1
 
 
@@ -154,29 +156,49 @@ def main(argv=None) -> int:
     device = resolve_device(args.device)
     res = {"device": device, "device_name": wp.get_device(device).name, "warp": wp.__version__,
            "date": time.strftime("%Y-%m-%d %H:%M"), "host": platform.node(), "runs": [], "agreement": [],
-           "quick": args.quick}
+           "errors": [], "quick": args.quick, "cdem": [], "mpm": []}
+    out = Path(args.out)
     t0 = time.perf_counter()
+
+    def stage(name: str, fn) -> None:
+        """Run one part of the check; a failure is recorded and the others still run. The results so far are
+        written after each part, so that a call cut off by its time limit still brings back what it measured."""
+        try:
+            fn()
+        except Exception as err:                    # noqa: BLE001 (a lent GPU's minutes: keep what the rest gives)
+            res["errors"].append({"stage": name, "error": f"{type(err).__name__}: {err}",
+                                  "traceback": traceback.format_exc()[-4000:]})
+            print(f"{name} FAILED: {type(err).__name__}: {err}", flush=True)
+        save(res, out)
+        print(f"{name} done at {time.perf_counter() - t0:.0f} s", flush=True)
+
     big = args.large and not args.quick
-    res["cdem"] = bench_cdem.run((20_000,) if args.quick else (1_000_000, 2_000_000)[: 1 + big], args.steps, device)
-    res["mpm"] = bench_mpm.run((40_000,) if args.quick else (1_600_000, 6_400_000)[: 1 + big], args.steps, device)
-    print(f"throughput done in {time.perf_counter() - t0:.0f} s", flush=True)
+    # MPM first: it builds no mesh, so it measures even where gmsh cannot run
+    stage("mpm", lambda: res["mpm"].extend(
+        bench_mpm.run((40_000,) if args.quick else (1_600_000, 6_400_000)[: 1 + big], args.steps, device)))
+    stage("cdem", lambda: res["cdem"].extend(
+        bench_cdem.run((20_000,) if args.quick else (1_000_000, 2_000_000)[: 1 + big], args.steps, device)))
     max_steps = 300 if args.quick else None
     for case in ("demo", "confined_P0"):
-        gpu = [_run_case(case, device, g, 1, max_steps) for g in ("on", "off")]
-        res["runs"] += gpu
+        for g in ("on", "off"):
+            stage(f"{case} graph {g}", lambda: res["runs"].append(_run_case(case, device, g, 1, max_steps)))
         if not args.skip_cpu:
-            cpu = _run_case(case, "cpu", "auto", 2, max_steps)
-            res["runs"].append(cpu)
-            res["agreement"] += [{"case": case, "graph": r["graph"], **agreement(cpu, r)} for r in gpu]
-            res["agreement"] += gpu_pairs(case, gpu)
-        print(f"{case} done at {time.perf_counter() - t0:.0f} s", flush=True)
-    text = markdown(res)
-    out = Path(args.out)
+            def on_cpu():
+                cpu = _run_case(case, "cpu", "auto", 2, max_steps)
+                res["runs"].append(cpu)
+                gpu = [r for r in res["runs"] if r["case"] == case and r["device"] == device and r is not cpu]
+                res["agreement"] += [{"case": case, "graph": r["graph"], **agreement(cpu, r)} for r in gpu]
+                res["agreement"] += gpu_pairs(case, gpu)
+            stage(f"{case} cpu", on_cpu)
+    print(markdown(res))
+    return 1 if res["errors"] else 0
+
+
+def save(res: dict, out: Path) -> None:
+    """OUT/gpu_check.json and OUT/gpu_check.md as they stand."""
     out.mkdir(parents=True, exist_ok=True)
     (out / "gpu_check.json").write_text(json.dumps(res, indent=1, default=str))
-    (out / "gpu_check.md").write_text(text + "\n")
-    print(text)
-    return 0
+    (out / "gpu_check.md").write_text(markdown(res) + "\n")
 
 
 if __name__ == "__main__":

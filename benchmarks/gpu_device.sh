@@ -20,7 +20,8 @@ for f in "$SITE"/syslibs/*; do
 done
 echo "bundled libraries used: $(ls "$SITE/syslibs_used" | tr '\n' ' ')"
 export LD_LIBRARY_PATH="$SITE/syslibs_used${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-python3 -c "import gmsh; gmsh.initialize(); gmsh.finalize(); print('gmsh', gmsh.__version__)"
+# (not fatal: without gmsh the MPM throughput still runs, and gpu_check records what failed)
+python3 -c "import gmsh; gmsh.initialize(); gmsh.finalize(); print('gmsh', gmsh.__version__)" || echo "gmsh FAILED"
 # the pack's kernel cache: blastfrac's modules compiled for sm_90 at packing time (gpu_pack.cuda_cache)
 export WARP_CACHE_PATH="$SITE/warp_cache"
 nvidia-smi --query-gpu=name,driver_version,memory.total,clocks.max.sm --format=csv,noheader || true
