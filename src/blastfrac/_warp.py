@@ -47,10 +47,7 @@ def kernel_module_names() -> list[str]:
     import importlib
     import pkgutil
 
-    try:                                         # Warp ≥ 1.10 keeps its internals in warp._src
-        from warp._src.context import user_modules
-    except ImportError:
-        from warp.context import user_modules
+    from warp._src.context import user_modules
 
     import blastfrac
 
