@@ -5,9 +5,10 @@
 # python benchmarks/gpu_check.py --compare <the fetched gpu_check.json>). Extra arguments go to gpu_check.py.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-SITE=/tmp/site
+# (GPU_SITE and GPU_PACK: where to unpack, and the parts; gpu_pack.py --check sets them to rehearse this here)
+SITE=${GPU_SITE:-/tmp/site}
 if [ ! -d "$SITE/warp" ]; then
-    python3 benchmarks/gpu_pack.py --unpack "$SITE"
+    python3 benchmarks/gpu_pack.py --unpack "$SITE" --parts "${GPU_PACK:-.gpu}"
 fi
 export PYTHONPATH="$SITE:$PWD/src"
 # the libraries libgmsh.so links against that this machine lacks, from the pack (gpu_pack.bundle_system_libraries):

@@ -19,10 +19,11 @@ included (~21 MB). Warp's wheel alone is 149 MB (its CUDA library, 299 MB unpack
    ``gpu_check.json`` and run the CPU side of the agreement check here
    (``python benchmarks/gpu_check.py --compare gpu_check.json``), at no device time.
 
-``python benchmarks/gpu_pack.py --python-version 3.11 --check`` builds a pack for this machine's Python, unpacks it
-into a scratch folder, imports Warp, gmsh, pydantic, meshio and tomli-w from there with every bundled library on
-LD_LIBRARY_PATH (``ldd`` must resolve them there) and runs the demo for 0.2 µs: the round trip the device depends
-on, tried at no device time.
+``python benchmarks/gpu_pack.py --python-version 3.11 --check`` builds a pack for this machine's Python and runs
+``gpu_device.sh`` with it on the CPU (``--device cpu --quick``): the parts joined and unpacked, the libraries and
+the kernel cache set up, ``gpu_check.py``'s parts run from the unpacked folder; then Warp, gmsh, pydantic, meshio and
+tomli-w must import from there, with every bundled library on LD_LIBRARY_PATH resolved there (``ldd``): the device's
+call rehearsed at no device time.
 """
 
 from __future__ import annotations
@@ -185,17 +186,25 @@ def unpack(target: Path, src: Path = PACK) -> dict:
 
 
 def check(python_version: str, part_mib: int) -> None:
-    """Build a pack for this Python, unpack it into a scratch folder and use it: the round trip, at no device time."""
+    """Build a pack for this Python and rehearse the device's call with it, at no device time: ``gpu_device.sh`` joins
+    the parts, unpacks them, sets up the libraries and the kernel cache and runs ``gpu_check.py --quick`` on the CPU,
+    with the packages taken from the unpacked folder (this environment's ``python3`` on PATH supplies numpy, scipy,
+    matplotlib and rich, as the device's image does); then libgmsh's bundled libraries must resolve from the pack."""
     out = Path(tempfile.mkdtemp(prefix="gpu_pack_"))
     try:
         parts = build(python_version, part_mib, out / "pack")
         print(f"{len(parts)} parts:", ", ".join(f"{p.name} {sum(f.stat().st_size for f in p.iterdir()) / 2**20:.1f} MiB"
                                                 for p in parts))
-        unpack(out / "site", out / "pack")
-        # the packages come from the unpacked folder, not this environment; the demo run below then uses them
+        env = {**os.environ, "GPU_PACK": str(out / "pack"), "GPU_SITE": str(out / "site"), "OUT": str(out / "gpu"),
+               "PATH": os.pathsep.join([str(Path(sys.executable).parent), os.environ.get("PATH", "")])}
+        subprocess.run(["bash", str(ROOT / "benchmarks" / "gpu_device.sh"), "--device", "cpu", "--quick"], env=env,
+                       check=True)
+        res = json.loads((out / "gpu" / "gpu_check.json").read_text())
+        assert not res["errors"] and len(res["runs"]) == 4 and res["mpm"] and res["cdem"], res["errors"]
+        print(f"gpu_device.sh: {len(res['runs'])} runs and both throughputs, no part failed")
+        # the packages came from the unpacked folder, not this environment
         code = ("import sys, warp as wp, gmsh, pydantic, meshio, tomli_w\n"
                 "assert all(m.__file__.startswith(sys.argv[1]) for m in (wp, gmsh, pydantic, meshio, tomli_w))\n"
-                "gmsh.initialize(); gmsh.finalize()\n"
                 "print('pack ok: warp', wp.__version__, 'gmsh', gmsh.__version__, 'from', sys.argv[1])")
         # every bundled library on the path (the device puts only those it lacks there): they must serve libgmsh
         env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(out / "site"), str(ROOT / "src")]),
@@ -208,9 +217,6 @@ def check(python_version: str, part_mib: int) -> None:
         assert bundled and not wrong, (sorted(bundled), wrong)
         print(f"libgmsh's {len(bundled)} bundled libraries resolve from the pack")
         subprocess.run([sys.executable, "-c", code, str(out / "site")], env=env, check=True)
-        subprocess.run([sys.executable, "-m", "blastfrac", "run", str(ROOT / "examples/circular_rock/demo.toml"),
-                        "--set", "simulation.end_time=2e-7", "--set", "output.paraview=false",
-                        "--set", "output.figures=false", "--out", str(out / "run")], env=env, check=True)
     finally:
         shutil.rmtree(out, ignore_errors=True)
 
@@ -221,12 +227,13 @@ def main(argv=None) -> int:
     ap.add_argument("--part-mib", type=int, default=None,
                     help="largest part [MiB]; default: what a call's 64 MiB leaves beside the working tree, less 1")
     ap.add_argument("--unpack", metavar="DIR", help="on the device: join the parts and extract them into DIR")
+    ap.add_argument("--parts", metavar="DIR", default=str(PACK), help="with --unpack: where the parts are (.gpu)")
     ap.add_argument("--check", action="store_true", help="build, unpack and import a pack here (scratch folders)")
     a = ap.parse_args(argv)
     if a.part_mib is None and not a.unpack:
         a.part_mib = 63 - int(tree_bytes() / 2**20 + 0.999)
     if a.unpack:
-        m = unpack(Path(a.unpack))
+        m = unpack(Path(a.unpack), Path(a.parts))
         print(f"joined {m['parts']} parts ({m['bytes'] / 2**20:.1f} MiB) and unpacked: {' '.join(m['pins'])}")
     elif a.check:
         check(a.python_version, a.part_mib)
