@@ -22,8 +22,8 @@ The GPU's atomics add in another order than the CPU's, and fracture amplifies ro
 these measures, not to the bit. Writes DIR/gpu_check.json and DIR/gpu_check.md (default DIR: $OUT, else
 out/gpu_check) after each part (MPM first, which needs no mesh; then CDEM and each run), so that a call cut off by
 its time limit brings back what it measured, and prints the markdown. A part that fails is recorded in the files
-(``errors``) and the others still run; the exit status is then 1. ``--quick``: small sizes and short runs, to try the script (on a CPU with
-``--device cpu``). Kernels compile on first use (a minute or two on a fresh machine: the CUDA compile of the
+(``errors``) and the others still run; the exit status is then 1. ``--quick``: small sizes and short runs, to try
+the script (on a CPU with ``--device cpu``). Kernels compile on first use (a minute or two on a fresh machine: the CUDA compile of the
 block-contact kernels alone takes ~50 s through NVRTC).
 """
 
@@ -107,8 +107,8 @@ def markdown(res: dict) -> str:
         lines.append(f"| {r['case']} | {r['device']} | {r['graph']} | {r['threads']} | {r['steps']} | "
                      f"{r['run_wall_s']:.2f} | {r['D']:.4f} | {r['energy']['budget_error_relative']:.3%} | "
                      f"{g.get('coupled_steps_replayed', 0)} |")
-    lines += ["", "| case | GPU run | D vs CPU ('on vs off': vs the other GPU run) | worst energy term (share of released) | budget error diff | within 2 % / 1 % |",
-              "|---|---|---:|---|---:|---|"]
+    lines += ["", ("| case | GPU run | D vs CPU ('on vs off': vs the other GPU run) | worst energy term (share of "
+                   "released) | budget error diff | within 2 % / 1 % |"), "|---|---|---:|---|---:|---|"]
     for a in res["agreement"]:
         lines.append(f"| {a['case']} | graph {a['graph']} | {a['D_rel']:+.2%} | {a['worst_term']} "
                      f"{a['worst_term_share']:+.3%} | {a['budget_diff']:+.3%} | {'yes' if a['ok'] else 'NO'} |")
@@ -181,9 +181,10 @@ def main(argv=None) -> int:
     max_steps = 300 if args.quick else None
     for case in ("demo", "confined_P0"):
         for g in ("on", "off"):
-            stage(f"{case} graph {g}", lambda: res["runs"].append(_run_case(case, device, g, 1, max_steps)))
+            stage(f"{case} graph {g}", lambda case=case, g=g: res["runs"].append(_run_case(case, device, g, 1,
+                                                                                              max_steps)))
         if not args.skip_cpu:
-            def on_cpu():
+            def on_cpu(case=case):
                 cpu = _run_case(case, "cpu", "auto", 2, max_steps)
                 res["runs"].append(cpu)
                 gpu = [r for r in res["runs"] if r["case"] == case and r["device"] == device and r is not cpu]

@@ -180,7 +180,7 @@ def test_nothing_is_read_back_or_allocated_inside_a_capture(tmp_path, monkeypatc
     rebuild steps run through the launches, and the run still ends where the launches' run ends, to the bit."""
     import warp as wp
 
-    import blastfrac.coupled_graph as coupled_graph
+    from blastfrac import coupled_graph
 
     inside, seen = [False], []
 

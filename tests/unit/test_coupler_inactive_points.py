@@ -8,12 +8,11 @@ account reads.
 """
 
 import numpy as np
+from test_coupled_graph import _scenario
 
 from blastfrac.coupling.kernels_contact import ACC_HEATED
 from blastfrac.scenario import scenario_from_dict
 from blastfrac.simulation import Simulation
-
-from test_coupled_graph import _scenario
 
 
 def test_a_deactivated_point_draws_no_contact_heat(tmp_path):

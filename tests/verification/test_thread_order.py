@@ -97,7 +97,7 @@ def test_a_step_does_not_depend_on_the_order_of_threads(tmp_path):
     script.write_text(CHILD)
     child = subprocess.run([sys.executable, str(script), str(tmp_path / "cache"), str(HERE),
                             str(tmp_path / "reversed.npz"), str(tmp_path / "start"), str(tmp_path / "reversed")],
-                           capture_output=True, text=True, timeout=900)
+                           check=False, capture_output=True, text=True, timeout=900)
     if child.returncode == 3:
         pytest.skip("Warp's CPU task loop is not the one this test rewrites (warp._src.codegen changed)")
     assert child.returncode == 0, child.stderr[-3000:]

@@ -211,12 +211,10 @@ def update_particle_kinematics(
     # then, on a non-periodic axis, the stencil's base cell floor(f - 1/2) within [0, n - 3]
     zx = fx - F64(0.5)
     zy = fy - F64(0.5)
-    if geo.px == 0:
-        if not (zx >= F64(0.0) and zx < wp.float64(geo.nx - 2)):
-            out = 1
-    if geo.py == 0:
-        if not (zy >= F64(0.0) and zy < wp.float64(geo.ny - 2)):
-            out = 1
+    if geo.px == 0 and not (zx >= F64(0.0) and zx < wp.float64(geo.nx - 2)):
+        out = 1
+    if geo.py == 0 and not (zy >= F64(0.0) and zy < wp.float64(geo.ny - 2)):
+        out = 1
     if out != 0 or not (J > F64(0.0)):
         active[p] = 0
         wp.atomic_add(deactivated, 0, 1)
