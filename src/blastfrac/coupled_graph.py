@@ -17,18 +17,6 @@ import warp as wp
 DT_SETTLED = 20
 
 
-def hash_builds_capturable(device) -> bool:
-    """Whether a captured step may build a ``wp.HashGrid`` (the gas–rock coupler's two hashes, at its list rebuilds).
-
-    On a CPU, Warp's graph replays each build into its own grid. A CUDA graph does not: Warp 1.19 fills one static host
-    descriptor shared by every float64 HashGrid and records its copy to the grid's device record, so at each replay
-    every captured build copies whatever that buffer holds then (the last grid built, here the other class's), and
-    the two hashes alias (native/hashgrid.cpp, hash_grid_update_device_impl). On a GPU the coupler's rebuild steps,
-    one in ``rebuild_interval``, therefore run through the launches. Block contact's captured hash is a cell grid of
-    its own (cdem/contact.py), which a graph replays like any kernel."""
-    return str(device) == "cpu"
-
-
 class CoupledGraphs:
     """The captured coupled steps of a Simulation: ``cache`` maps the coupler's and the crack gas's keys to graphs,
     all captured for ``key`` (the rest of what they hold); a change of ``key`` drops them."""
@@ -52,12 +40,10 @@ class CoupledGraphs:
         start or of a change of Δt (while the gas sets Δt, early in a blast, most of its estimates change it, and a
         graph would serve a few steps for the cost of its capture), before the first passes of block contact and
         the coupler (they build their caches on the host), with pulses on a GPU (CDEMSolver.step_captured), and
-        from a failed capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning; and on a GPU
-        at the coupler's list rebuilds (``hash_builds_capturable``)."""
+        from a failed capture on (a GPU without conditional graph nodes, CUDA < 12.4), with a warning."""
         m, c, cp, gas = sim.model, sim.cdem.contact, sim.coupler, sim.gas
         if cp.cell_size == 0.0 or sim.cdem.dt_prev != dt or sim.steps - sim._dt_since < DT_SETTLED or \
-                (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu") or \
-                (cp.rebuild_due() and not hash_builds_capturable(m.device)):
+                (c is not None and c.active and not c.capturable()) or (m.pulses and m.device != "cpu"):
             return False
         rest = (id(sim.state), dt, sim.alpha, m.breakable, None if c is None else c.graph_key(), gas.grid.box,
                 cp.graph_held(), sim.wall_load is not None)     # (graphs dropped on a change)

@@ -168,16 +168,16 @@ def test_a_failed_capture_falls_back_to_the_launches(tmp_path, monkeypatch, wher
         assert np.array_equal(a[name], b[name]), name
 
 
-@pytest.mark.parametrize("gpu_rules", [False, True], ids=["cpu", "gpu_rules"])
-def test_nothing_is_read_back_or_allocated_inside_a_capture(tmp_path, monkeypatch, gpu_rules):
+def test_nothing_is_read_back_or_allocated_inside_a_capture(tmp_path, monkeypatch):
     """What a CUDA stream capture refuses, refused here on the CPU: inside the capture of a coupled step no array is
     read to the host (``numpy``, ``list``), nothing synchronises, and nothing is allocated or uploaded from host data
     (views of existing arrays are fine). A CPU capture would record such a step without complaint, and the
     bit-identity above only catches the reads whose values change what the step does; on a GPU each of them fails
-    the capture (the run then falls back to the launches, issue 14 item 1). Crack gas on, so that every captured
-    stage takes part. With ``gpu_rules`` the step follows what it does on a GPU, where a captured wp.HashGrid build
-    leaves the coupler's two hashes aliased (coupled_graph.hash_builds_capturable): no captured step builds one, the
-    rebuild steps run through the launches, and the run still ends where the launches' run ends, to the bit."""
+    the capture (the run then falls back to the launches, issue 14 item 1). Nor is a wp.HashGrid built: a CUDA graph
+    replays such a build by copying its descriptor from one host buffer that every float64 grid shares (Warp 1.19,
+    native/hashgrid.cpp), so two captured builds would alias; the coupler's hashes are cell grids of its own
+    (kernels_contact.ListedHash), and its rebuild steps are replayed too. Crack gas on, so that every captured stage
+    takes part; the run still ends where the launches' run ends, to the bit."""
     import warp as wp
 
     from blastfrac import coupled_graph
@@ -201,9 +201,7 @@ def test_nothing_is_read_back_or_allocated_inside_a_capture(tmp_path, monkeypatc
     for name in ("synchronize", "synchronize_device", "synchronize_stream", "empty", "zeros", "full", "clone",
                  "empty_like", "zeros_like", "full_like", "from_numpy"):
         guard(wp, name)
-    if gpu_rules:
-        monkeypatch.setattr(coupled_graph, "hash_builds_capturable", lambda device: False)
-        guard(wp.HashGrid, "build")
+    guard(wp.HashGrid, "build")
     real_capture = coupled_graph.CoupledGraphs._capture
 
     def capture(self, sim, dt):
@@ -224,8 +222,8 @@ def test_nothing_is_read_back_or_allocated_inside_a_capture(tmp_path, monkeypatc
         replayed_rebuilds += rebuild and cap.coupled_graph_steps > replayed
     assert not seen and not cap.warnings, (seen, cap.warnings)
     assert cap.coupled_graph and cap.coupled_graph_captures > 4 and rebuilds > 50
-    # the graphs carried most steps, and under the GPU's rule none of the rebuilds
-    assert cap.coupled_graph_steps > 200 and (replayed_rebuilds == 0) == gpu_rules, replayed_rebuilds
+    # the graphs carried most steps, the coupler's rebuilds among them
+    assert cap.coupled_graph_steps > 200 and replayed_rebuilds > 20, replayed_rebuilds
     assert cap.crack_gas.gas.mass.numpy().sum() > 0          # the captured stages carried gas into the cracks
     a, b = _state(ref), _state(cap)
     for name in a:

@@ -3,8 +3,9 @@
 Per step (``apply``): the forces on the gas particles are written to ``mpm.f_ext_p`` and their moments about
 the particle centres to ``mpm.f_ext_moment`` (they enter the grid in the next P2G, at the contact points) and
 the reactions are added to the rock node forces (and kept in ``f_react`` for the work bookkeeping). Candidate elements are those with an
-exposed edge; their centroids are hashed (``wp.HashGrid``) and each particle queries the hash, so the cost is
-linear in the number of particles. The list is rebuilt every ``rebuild_interval`` steps; between rebuilds the
+exposed edge; their centroids are hashed (a cell grid in wp.HashGrid's cells and order, of our own so that a CUDA
+graph replays its builds: kernels_contact.ListedHash) and each particle queries the hash, so the cost is linear in the
+number of particles. The list is rebuilt every ``rebuild_interval`` steps; between rebuilds the
 exposure of every listed edge is re-tested, and a newly cracked element joins at the next rebuild.
 
 Nothing the kernels need is read back: the list's length and largest reach stay on the device (the kernels read
@@ -13,8 +14,9 @@ coarse far mesh do not widen every particle's search; the split and the cell wid
 of CELL_GROWTH (``note_reach``: from the reach the host last read, at the MPM box's renewal, where it reads the box
 anyway), so they change a few times a run. So a step can be captured as a graph
 (``captured = True``, set by Simulation while it captures): its launches then cover the list's capacity (the
-threads beyond its length return), its hashes hold the whole capacity with the listed points as group 0 (the points
-and the order a search meets them in are those of a hash of the listed points alone), and the empty list's branch
+threads beyond its length return), its hashes hold the whole capacity with the points past the list's length filed
+after every cell (the points and the order a search meets them in are those of a hash of the listed points alone),
+and the empty list's branch
 is taken on the device (``wp.capture_if``). Outside a capture the launches cover the list as the host reads it (a
 view on a CPU), so that a large rock with a short list costs what the list does.
 """
@@ -31,8 +33,8 @@ from ..mpm.grid import BOX_STEPS
 from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
 from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEAT_NEW, ACC_HEATED, ACC_SIZE, ACC_STORED, LARGE,
                               REACH_COUNT, REACH_MAX, REACH_SUM, SMALL, account_rock_work_and_clear,
-                              accumulate_gas_contact_work, add_reactions_with_work, collect_exposed_elements, eval_particle_edge_contact, group_listed_points,
-                              heat_gas_from_contacts)
+                              accumulate_gas_contact_work, add_reactions_with_work, collect_exposed_elements, eval_particle_edge_contact,
+                              hash_listed_points, heat_gas_from_contacts, listed_cell_ranges, ListedHash)
 
 
 #: ratio of one hash cell width to the next (GasRockCoupler.note_reach) [-]
@@ -86,7 +88,6 @@ class GasRockCoupler:
         self.cls_elems = wp.zeros(2 * E, dtype=wp.int32, device=d)      # class c from c·E on
         self.cls_points = wp.zeros(2 * E, dtype=wp.vec3d, device=d)
         self.cls_count = wp.zeros(2, dtype=wp.int32, device=d)
-        self.groups = wp.zeros(E, dtype=wp.int32, device=d)      # hash groups of a captured rebuild (0: listed)
         self.acc = wp.zeros(ACC_SIZE, dtype=wp.float64, device=d)
         self.diss_p = wp.zeros(max(1, mpm.n), dtype=wp.float64, device=d)   # contacts' dissipation rate per point [W/m]
         self._launch = Launcher()                 # recorded launches of the per-step kernels (_warp.Launcher)
@@ -97,11 +98,21 @@ class GasRockCoupler:
         nh = max(1, mpm.n) * CONTACT_HISTORY
         self._hist = [(wp.full(nh, -1, dtype=wp.int32, device=d), wp.zeros(nh, dtype=wp.float64, device=d),
                        wp.zeros(nh, dtype=wp.float64, device=d)) for _ in range(2)]
+        # the two classes' hashes (kernels_contact.ListedHash: wp.HashGrid's cells and order in arrays of our own,
+        # which a graph replays; the sort's keys and values take twice the list's capacity)
         dim = int(min(1024, max(16, math.sqrt(E))))
-        self.grids = [wp.HashGrid(dim, dim, 1, device=d, dtype=wp.float64) for _ in range(2)]   # SMALL, LARGE
-        if d != "cpu":       # a captured build of the whole capacity then allocates nothing inside a CUDA graph
-            for g in self.grids:
-                g.reserve(E, with_groups=True)
+        self.hash = ListedHash()
+        self.hash.values = wp.zeros(2 * 2 * E, dtype=wp.int32, device=d)
+        self.hash.starts = wp.zeros(2 * dim * dim, dtype=wp.int32, device=d)
+        self.hash.ends = wp.zeros(2 * dim * dim, dtype=wp.int32, device=d)
+        self.hash.cell_inv = wp.vec2d(0.0, 0.0)
+        self.hash.dim = dim
+        self.hash.stride = 2 * E
+        self._keys = wp.zeros(2 * E, dtype=wp.int32, device=d)
+        # each class's part of them (views made once: the launches' records keep their arrays)
+        self._hash_views = [(self.hash.values[c * 2 * E: (c + 1) * 2 * E],
+                             self.hash.starts[c * dim * dim: (c + 1) * dim * dim],
+                             self.hash.ends[c * dim * dim: (c + 1) * dim * dim]) for c in (SMALL, LARGE)]
         # search radius = the list's largest reach (device) + this margin [m]: contact radius r_max with its preload
         self.query_margin = (1.0 + MAX_PRESSURE_OFFSET_NP) * self.r_max
         self.cell_size = 0.0                    # the small hash's cell width [m] (note_reach; 0 until the first rebuild)
@@ -175,11 +186,7 @@ class GasRockCoupler:
                   outputs=[self.count, self.elems, self.cls_count, self.cls_elems, self.cls_points, self.reach],
                   device=m.device)
         if self.captured:
-            for c, cell in ((SMALL, self.cell_size), (LARGE, self.cell_large)):
-                wp.launch(group_listed_points, dim=m.element_count, inputs=[self.cls_count, c, self.groups],
-                          device=m.device)
-                self.grids[c].build(self.cls_points[c * m.element_count: (c + 1) * m.element_count], cell,
-                                    groups=self.groups)
+            self.build_hash(captured=True)
             self._count_stale = True
         else:
             self._count_stale = True
@@ -221,13 +228,27 @@ class GasRockCoupler:
         k = max(0, math.floor(math.log(radius / self.query_margin) / math.log(CELL_GROWTH)))
         return self.query_margin * CELL_GROWTH ** k
 
-    def build_hash(self) -> None:
-        """The hashes of the listed points of each class (n_class of them) with their cell widths (a rebuild outside
-        a capture, a restart)."""
+    def build_hash(self, captured: bool = False) -> None:
+        """The hashes of the listed points of each class with their cell widths: over the n_class points the host
+        read (a rebuild outside a capture, a restart), or over the list's capacity with the points past its length
+        (on the device) sorted after every cell (a captured rebuild); either way the same cells in the same order.
+        Each is a stable sort by cell, as wp.HashGrid builds its own."""
+        m, h = self.model, self.hash
+        E, dim = m.element_count, h.dim
+        h.cell_inv = wp.vec2d(1.0 / self.cell_size if self.cell_size else 0.0,
+                              1.0 / self.cell_large if self.cell_large else 0.0)
         for c, cell in ((SMALL, self.cell_size), (LARGE, self.cell_large)):
-            if self.n_class[c]:
-                E = self.model.element_count
-                self.grids[c].build(self.cls_points[c * E: c * E + self.n_class[c]], cell)
+            n = E if captured else self.n_class[c]
+            if n == 0:
+                continue                     # (the search skips an empty class)
+            values, starts, ends = self._hash_views[c]
+            self._launch(hash_listed_points, n, [self.cls_count, c, self.cls_points, c * E, wp.float64(1.0 / cell),
+                                                 dim, self._keys, values], device=m.device, key=c)
+            wp.utils.radix_sort_pairs(self._keys, values, n)
+            starts.zero_()
+            ends.zero_()
+            self._launch(listed_cell_ranges, n, [self._keys, n, dim, c * dim * dim, h.starts, h.ends],
+                         device=m.device, key=c)
 
     def _read_count(self) -> None:
         """n_exposed and n_class from the device after a rebuild (a view on a CPU, a synchronisation on a GPU)."""
@@ -303,7 +324,7 @@ class GasRockCoupler:
     def _contacts(self, state, dt: float, w_old: float, h_in, h_out) -> None:
         mpm, m = self.mpm, self.model
         self._launch(eval_particle_edge_contact, dim=mpm.n,
-                     inputs=[self.grids[SMALL].id, self.grids[LARGE].id, self.cls_count, self.cls_elems,
+                     inputs=[self.hash, self.cls_count, self.cls_elems,
                              self.cls_points, self.slot_iface, state.pair_mode,
                              state.x, state.v, m.node_mass, mpm.x, mpm.v_pic, mpm.grad_v, mpm.mass, mpm.vol, mpm.p,
                              mpm.rho, mpm.active, wp.float64(self.kc), wp.float64(self.force_cap),

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import warp as wp
 
+from blastfrac.cdem.contact_hash import cell_coord, cell_end, cell_wrap
 from blastfrac.mpm.bodies import MAT_GAS
 
 from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap,
@@ -94,19 +95,58 @@ def collect_exposed_elements(
     wp.atomic_add(reach, REACH_COUNT, wp.float64(1.0))
 
 
+@wp.struct
+class ListedHash:
+    """The listed elements' hashes, one per size class (GasRockCoupler): cell grids of their centroids in
+    wp.HashGrid's cells and order (dim × dim cells, coordinates wrapped, each cell's points in list order), which a
+    CUDA graph replays like any kernel (a captured wp.HashGrid build is not: coupled_graph.py). Class c's sorted
+    list positions are values[c·stride + j], its cells' ranges starts/ends[c·dim² + cell]."""
+
+    values: wp.array(dtype=wp.int32)     # list positions, sorted by cell (class c from c·stride on)
+    starts: wp.array(dtype=wp.int32)     # first sorted position of each cell (class c from c·dim² on)
+    ends: wp.array(dtype=wp.int32)       # one past its last
+    cell_inv: wp.vec2d                   # 1 / cell width of each class [1/m]
+    dim: wp.int32                        # cells along x and y
+    stride: wp.int32                     # values per class
+
+
 @wp.kernel
-def group_listed_points(cls_count: wp.array(dtype=wp.int32), cls: wp.int32, groups: wp.array(dtype=wp.int32)):
-    """groups[k] = 0 for the listed points of size class ``cls`` (k < cls_count[cls]), 1 for the rest of the list's
-    capacity: the groups of a hash built over the whole capacity, whose searches then meet the listed points only (a
-    captured step, whose launch sizes cannot depend on the count)."""
+def hash_listed_points(cls_count: wp.array(dtype=wp.int32), cls: wp.int32, cls_points: wp.array(dtype=wp.vec3d),
+                       first: wp.int32, cell_inv: wp.float64, dim: wp.int32, keys: wp.array(dtype=wp.int32),
+                       values: wp.array(dtype=wp.int32)):
+    """keys[k], values[k] for the sort of class ``cls``'s listed points by cell: the cell wp.HashGrid files centroid
+    k in (its row-major index) and k; past the list's length (a captured rebuild covers the capacity) dim², after
+    every cell."""
     k = wp.tid()
-    groups[k] = wp.where(k < cls_count[cls], 0, 1)
+    key = dim * dim
+    if k < cls_count[cls]:
+        c = cls_points[first + k]
+        key = cell_wrap(cell_coord(c[1] * cell_inv), dim) * dim + cell_wrap(cell_coord(c[0] * cell_inv), dim)
+    keys[k] = key
+    values[k] = k
+
+
+@wp.kernel
+def listed_cell_ranges(keys: wp.array(dtype=wp.int32), count: wp.int32, dim: wp.int32, cbase: wp.int32,
+                       starts: wp.array(dtype=wp.int32), ends: wp.array(dtype=wp.int32)):
+    """After the stable sort by cell (keys, count of them): each cell's range of sorted positions."""
+    j = wp.tid()
+    c = keys[j]
+    if c >= dim * dim:
+        return                                          # past the list's length
+    if j == 0:
+        starts[cbase + c] = j
+    elif keys[j - 1] != c:
+        starts[cbase + c] = j
+    if j == count - 1:
+        ends[cbase + c] = j + 1
+    elif keys[j + 1] != c:
+        ends[cbase + c] = j + 1
 
 
 @wp.kernel
 def eval_particle_edge_contact(
-    grid_small: wp.uint64,
-    grid_large: wp.uint64,
+    hsh: ListedHash,
     cls_count: wp.array(dtype=wp.int32),
     cls_elems: wp.array(dtype=wp.int32),
     cls_points: wp.array(dtype=wp.vec3d),
@@ -154,14 +194,13 @@ def eval_particle_edge_contact(
     which the step adds to the rock's forces: coupler.add_reactions), METHOD §3.
 
     cls_points, cls_elems, cls_count: the listed elements by size class (collect_exposed_elements): centroids at the
-    last rebuild with their reach as z [m], elements, counts. Two searches: the small elements' hash (grid_small)
-    within ``split`` [m] (their reach + query_margin is within it) or the largest search radius where that is less
-    (split = ∞: one class), then, where there are any, the large ones' (grid_large) within reach[REACH_MAX] +
+    last rebuild with their reach as z [m], elements, counts. Two searches through ``hsh`` (ListedHash): the small
+    elements' hash within ``split`` [m] (their reach + query_margin is within it) or the largest search radius where
+    that is less (split = ∞: one class), then, where there are any, the large ones' within reach[REACH_MAX] +
     query_margin [m] (the list's largest reach, read here, so that a rebuild reads nothing back): the few large
-    blocks of a coarse far mesh no longer widen every particle's search.
-    Each search asks for group 0: a hash built over the list's whole capacity (a captured step, GasRockCoupler) holds
-    the listed points as group 0, and a hash of the listed points alone has no groups, so it meets them all, in the
-    same order.
+    blocks of a coarse far mesh no longer widen every particle's search. A hash built over the list's whole capacity
+    (a captured step, GasRockCoupler) files the points past its length after every cell, so a search meets the
+    listed points of a hash of those alone, in the same order.
     hist_*_in / hist_*_out: the particle's contacts of the previous / this step, CONTACT_HISTORY slots
     each (8·element + feature, ignored initial overlap δ₀ [m], effective overlap δ − δ₀ [m]); feature 0–2:
     edge k, 3–5: vertex k; −1 marks an empty slot.
@@ -197,92 +236,103 @@ def eval_particle_edge_contact(
     for cls in range(2):
         if cls_count[cls] == 0:                   # (an empty class's hash may hold an older list)
             continue
-        grid = wp.where(cls == SMALL, grid_small, grid_large)
         first = cls * (cls_points.shape[0] // 2)       # class c from c·(elements) on
         query_radius = reach[REACH_MAX] + query_margin
         if cls == SMALL:
             query_radius = wp.min(split, query_radius)
-        query = wp.hash_grid_query(grid, wp.vec3d(xp[0], xp[1], zero), query_radius, 0)
-        idx = int(0)
-        while wp.hash_grid_query_next(query, idx):
-            # the hash returns whole cells: skip elements whose reach (from the centroid listed at the last rebuild,
-            # with the same allowance for motion as the search radius; the point's z) cannot meet the particle's
-            # contact disk, before loading anything else of them
-            c = cls_points[first + idx]
-            dx = xp[0] - c[0]
-            dy = xp[1] - c[1]
-            lim = c[2] + rc
-            if dx * dx + dy * dy > lim * lim:
-                continue
-            e = cls_elems[first + idx]
-            best = wp.float64(-1.0)
-            bn = wp.vec2d(zero, zero)
-            ia = int(-1)
-            ib = int(-1)
-            bk = int(-1)
-            bxi = wp.float64(0.0)
-            for k in range(3):
-                s = 3 * e + k
-                if slot_exposed(s, slot_iface, pair_mode):
-                    b = 3 * e + (k + 1) % 3
-                    de, ne, xie = edge_overlap(xp, rc, x_rock[s], x_rock[b])
-                    if de > best:
-                        best = de
-                        bn = ne
-                        ia = s
-                        ib = b
-                        bk = k
-                        bxi = xie
-            for k in range(3):
-                a = 3 * e + k
-                if slot_exposed(a, slot_iface, pair_mode) or slot_exposed(3 * e + (k + 2) % 3, slot_iface, pair_mode):
-                    dv, nv = vertex_overlap(xp, rc, x_rock[a])
-                    if dv > best:
-                        best = dv
-                        bn = nv
-                        ia = a
-                        ib = a
-                        bk = 3 + k
-                        bxi = zero
-            if best > zero:
-                wa = one - bxi
-                mc = wa * m_rock[ia] + bxi * m_rock[ib]
-                vc = wa * v_rock[ia] + bxi * v_rock[ib]
-                cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
-                arm = -surface * rp * bn                       # contact point (disk surface) − particle centre [m]
-                vrel = vp + Lp * arm - vc                      # gas velocity at the contact point − wall velocity
-                # initial overlap δ₀ (ignored part of the overlap): kept from the last step's contact with element e, else
-                # what a new contact cannot explain. The deepest feature of an element (edge or vertex bk) can change,
-                # e.g. for a particle an element rotated over; δ₀ belonged to the old feature, so it is re-based to keep
-                # the force continuous, δ₀ = δ − (δ − δ₀)_last. (Reusing it against the new feature made the force jump
-                # by k_c times the difference, 140 µm once in a single-hole blast, and the run went unstable; treating
-                # the switch as a new contact gave the slack k_c·0.1r_p for free at every switch.)
-                key = 8 * e + bk
-                d0 = wp.float64(-1.0)
-                for h in range(CONTACT_HISTORY):
-                    he = hist_e_in[h0 + h]
-                    if he == key:
-                        d0 = wp.min(hist_d_in[h0 + h], best)
-                    elif he >= 0 and he // 8 == e:
-                        d0 = wp.max(best - hist_x_in[h0 + h], zero)
-                if d0 < zero:
-                    d0 = initial_overlap(best, wp.dot(vrel, bn), dt, rp)
-                if ncon < CONTACT_HISTORY:
-                    hist_e_out[h0 + ncon] = key
-                    hist_d_out[h0 + ncon] = d0
-                    hist_x_out[h0 + ncon] = best - d0
-                best = best - d0
-                fcap = wp.float64(0.0)
-                if kappa > zero:
-                    fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
-                f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
-                qsum = qsum + pw
-                fsum = fsum + f
-                msum = msum + wp.outer(f, arm)
-                wp.atomic_add(f_react, ia, -wa * f)
-                wp.atomic_add(f_react, ib, -bxi * f)
-                stored = stored + wp.float64(0.5) * kc * best * best
-                ncon = ncon + 1
+        # the cells wp.HashGrid's search would visit, in its order, each cell's points in list order
+        dim = hsh.dim
+        inv = hsh.cell_inv[cls]
+        xs = cell_coord((xp[0] - query_radius) * inv)
+        xe = cell_end(xs, cell_coord((xp[0] + query_radius) * inv), dim)
+        ys = cell_coord((xp[1] - query_radius) * inv)
+        ye = cell_end(ys, cell_coord((xp[1] + query_radius) * inv), dim)
+        for cy in range(ys, ye + 1):
+            row = cls * dim * dim + cell_wrap(cy, dim) * dim
+            for cx in range(xs, xe + 1):
+                cc = row + cell_wrap(cx, dim)
+                for j in range(hsh.starts[cc], hsh.ends[cc]):
+                    idx = hsh.values[cls * hsh.stride + j]
+                    # the hash holds whole cells: skip elements whose reach (from the centroid listed at the last
+                    # rebuild, with the same allowance for motion as the search radius; the point's z) cannot meet
+                    # the particle's contact disk, before loading anything else of them
+                    c = cls_points[first + idx]
+                    dx = xp[0] - c[0]
+                    dy = xp[1] - c[1]
+                    lim = c[2] + rc
+                    if dx * dx + dy * dy > lim * lim:
+                        continue
+                    e = cls_elems[first + idx]
+                    best = wp.float64(-1.0)
+                    bn = wp.vec2d(zero, zero)
+                    ia = int(-1)
+                    ib = int(-1)
+                    bk = int(-1)
+                    bxi = wp.float64(0.0)
+                    for k in range(3):
+                        s = 3 * e + k
+                        if slot_exposed(s, slot_iface, pair_mode):
+                            b = 3 * e + (k + 1) % 3
+                            de, ne, xie = edge_overlap(xp, rc, x_rock[s], x_rock[b])
+                            if de > best:
+                                best = de
+                                bn = ne
+                                ia = s
+                                ib = b
+                                bk = k
+                                bxi = xie
+                    for k in range(3):
+                        a = 3 * e + k
+                        if slot_exposed(a, slot_iface, pair_mode) or \
+                                slot_exposed(3 * e + (k + 2) % 3, slot_iface, pair_mode):
+                            dv, nv = vertex_overlap(xp, rc, x_rock[a])
+                            if dv > best:
+                                best = dv
+                                bn = nv
+                                ia = a
+                                ib = a
+                                bk = 3 + k
+                                bxi = zero
+                    if best > zero:
+                        wa = one - bxi
+                        mc = wa * m_rock[ia] + bxi * m_rock[ib]
+                        vc = wa * v_rock[ia] + bxi * v_rock[ib]
+                        cn = wp.float64(2.0) * zeta * wp.sqrt(kc * mp * mc / (mp + mc))
+                        arm = -surface * rp * bn            # contact point (disk surface) − particle centre [m]
+                        vrel = vp + Lp * arm - vc           # gas velocity at the contact point − wall velocity
+                        # initial overlap δ₀ (ignored part of the overlap): kept from the last step's contact with
+                        # element e, else what a new contact cannot explain. The deepest feature of an element (edge
+                        # or vertex bk) can change, e.g. for a particle an element rotated over; δ₀ belonged to the
+                        # old feature, so it is re-based to keep the force continuous, δ₀ = δ − (δ − δ₀)_last.
+                        # (Reusing it against the new feature made the force jump by k_c times the difference,
+                        # 140 µm once in a single-hole blast, and the run went unstable; treating the switch as a new
+                        # contact gave the slack k_c·0.1r_p for free at every switch.)
+                        key = 8 * e + bk
+                        d0 = wp.float64(-1.0)
+                        for h in range(CONTACT_HISTORY):
+                            he = hist_e_in[h0 + h]
+                            if he == key:
+                                d0 = wp.min(hist_d_in[h0 + h], best)
+                            elif he >= 0 and he // 8 == e:
+                                d0 = wp.max(best - hist_x_in[h0 + h], zero)
+                        if d0 < zero:
+                            d0 = initial_overlap(best, wp.dot(vrel, bn), dt, rp)
+                        if ncon < CONTACT_HISTORY:
+                            hist_e_out[h0 + ncon] = key
+                            hist_d_out[h0 + ncon] = d0
+                            hist_x_out[h0 + ncon] = best - d0
+                        best = best - d0
+                        fcap = wp.float64(0.0)
+                        if kappa > zero:
+                            fcap = normal_force_cap(kappa, p_p[p], rho_p[p], wp.dot(vrel, bn), rp)
+                        f, pw = contact_force(best, bn, vrel, kc, cn, mu, fcap)
+                        qsum = qsum + pw
+                        fsum = fsum + f
+                        msum = msum + wp.outer(f, arm)
+                        wp.atomic_add(f_react, ia, -wa * f)
+                        wp.atomic_add(f_react, ib, -bxi * f)
+                        stored = stored + wp.float64(0.5) * kc * best * best
+                        ncon = ncon + 1
     f_p[p] = fsum
     fm_p[p] = msum
     work = work + w_new * contact_power(fsum, msum, vp, Lp)         # this step's forces, their first half
