@@ -8,7 +8,8 @@ rewritten before anything compiles, in a kernel cache of its own). Without an or
 by the round-off of sums made in the other order: no spring breaks or drops differently, no crack cell wets
 differently, and no float array moves by more than round-off over the steps.
 
-Block contact runs in the form a GPU runs (``BlockContact._cpu = False``: one thread per listed node or vertex, its
+The gas–rock coupler's listed elements, which its threads append in the order they arrive, must come out in the
+same order too (it sorts them by element). Block contact runs in the form a GPU runs (``BlockContact._cpu = False``: one thread per listed node or vertex, its
 lists filled by atomic appends), which a CPU otherwise runs as one thread over each list in node order; run in order
 on a CPU the two forms give the same bits. The child first runs a kernel whose threads do read their neighbour's
 write, to show that the reversal took effect. A spring or cell that sits on a threshold could in principle flip
@@ -82,7 +83,12 @@ def run_from(checkpoint_dir: str, out_dir: str) -> dict:
     sim.cdem.contact._cpu = False          # block contact's GPU form: one thread per listed item, lists by atomics
     sim.run(progress=False, restart=Path(out_dir) / CHECKPOINT_NAME)
     assert sim.steps == START + STEPS
-    return _state(sim)
+    out = _state(sim)
+    cp, E = sim.coupler, sim.model.element_count
+    n = cp.cls_count.numpy()
+    # the coupler's listed elements by class, as its last rebuild left them (appended by one thread each)
+    out["coupler_list"] = np.concatenate([cp.cls_elems.numpy()[c * E: c * E + n[c]] for c in (0, 1)])
+    return out
 
 
 def test_a_step_does_not_depend_on_the_order_of_threads(tmp_path):

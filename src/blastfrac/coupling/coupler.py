@@ -34,7 +34,8 @@ from .particle_edge import CONTACT_HISTORY, MAX_PRESSURE_OFFSET_NP
 from .kernels_contact import (ACC_ABSORBED, ACC_CONTACTS, ACC_HEAT_NEW, ACC_HEATED, ACC_SIZE, ACC_STORED, LARGE,
                               REACH_COUNT, REACH_MAX, REACH_SUM, SMALL, account_rock_work_and_clear,
                               accumulate_gas_contact_work, add_reactions_with_work, collect_exposed_elements, eval_particle_edge_contact,
-                              hash_listed_points, heat_gas_from_contacts, listed_cell_ranges, ListedHash)
+                              gather_listed, hash_listed_points, heat_gas_from_contacts, listed_cell_ranges,
+                              listed_element_keys, ListedHash)
 
 
 #: ratio of one hash cell width to the next (GasRockCoupler.note_reach) [-]
@@ -109,6 +110,9 @@ class GasRockCoupler:
         self.hash.dim = dim
         self.hash.stride = 2 * E
         self._keys = wp.zeros(2 * E, dtype=wp.int32, device=d)
+        self._order = wp.zeros(2 * E, dtype=wp.int32, device=d)             # a class's list, sorted by element
+        self._tmp_elems = wp.zeros(E, dtype=wp.int32, device=d)
+        self._tmp_points = wp.zeros(E, dtype=wp.vec3d, device=d)
         # each class's part of them (views made once: the launches' records keep their arrays)
         self._hash_views = [(self.hash.values[c * 2 * E: (c + 1) * 2 * E],
                              self.hash.starts[c * dim * dim: (c + 1) * dim * dim],
@@ -232,7 +236,8 @@ class GasRockCoupler:
         """The hashes of the listed points of each class with their cell widths: over the n_class points the host
         read (a rebuild outside a capture, a restart), or over the list's capacity with the points past its length
         (on the device) sorted after every cell (a captured rebuild); either way the same cells in the same order.
-        Each is a stable sort by cell, as wp.HashGrid builds its own."""
+        Each class's list is first put in element order (the order a CPU appends it in; a GPU appends in any order),
+        then hashed by a stable sort by cell, as wp.HashGrid builds its own."""
         m, h = self.model, self.hash
         E, dim = m.element_count, h.dim
         h.cell_inv = wp.vec2d(1.0 / self.cell_size if self.cell_size else 0.0,
@@ -241,6 +246,14 @@ class GasRockCoupler:
             n = E if captured else self.n_class[c]
             if n == 0:
                 continue                     # (the search skips an empty class)
+            # the class's list in element order (a CPU appends it so; a GPU in any order)
+            self._launch(listed_element_keys, n, [self.cls_count, c, self.cls_elems, c * E, E, self._keys,
+                                                  self._order], device=m.device, key=c)
+            wp.utils.radix_sort_pairs(self._keys, self._order, n)
+            self._launch(gather_listed, n, [self._order, self.cls_count, c, c * E, self.cls_elems, self.cls_points,
+                                            self._tmp_elems, self._tmp_points], device=m.device, key=c)
+            wp.copy(self.cls_elems, self._tmp_elems, dest_offset=c * E, count=n)
+            wp.copy(self.cls_points, self._tmp_points, dest_offset=c * E, count=n)
             values, starts, ends = self._hash_views[c]
             self._launch(hash_listed_points, n, [self.cls_count, c, self.cls_points, c * E, wp.float64(1.0 / cell),
                                                  dim, self._keys, values], device=m.device, key=c)

@@ -111,6 +111,34 @@ class ListedHash:
 
 
 @wp.kernel
+def listed_element_keys(cls_count: wp.array(dtype=wp.int32), cls: wp.int32, cls_elems: wp.array(dtype=wp.int32),
+                        first: wp.int32, sentinel: wp.int32, keys: wp.array(dtype=wp.int32),
+                        values: wp.array(dtype=wp.int32)):
+    """keys[k], values[k] for the sort of class ``cls``'s list by element: element k and k; past the list's length
+    ``sentinel`` (the element count), after every element. collect_exposed_elements appends in the order its threads
+    arrive, which on a GPU changes from run to run; sorted, the list (and so the order in which a particle meets its
+    elements, and which CONTACT_HISTORY of them it keeps) is the same on every device, as a CPU fills it."""
+    k = wp.tid()
+    key = sentinel
+    if k < cls_count[cls]:
+        key = cls_elems[first + k]
+    keys[k] = key
+    values[k] = k
+
+
+@wp.kernel
+def gather_listed(order: wp.array(dtype=wp.int32), cls_count: wp.array(dtype=wp.int32), cls: wp.int32,
+                  first: wp.int32, cls_elems: wp.array(dtype=wp.int32), cls_points: wp.array(dtype=wp.vec3d),
+                  out_elems: wp.array(dtype=wp.int32), out_points: wp.array(dtype=wp.vec3d)):
+    """Class ``cls``'s listed elements and points in the sorted order ``order`` (copied back by the caller)."""
+    k = wp.tid()
+    if k < cls_count[cls]:
+        j = first + order[k]
+        out_elems[k] = cls_elems[j]
+        out_points[k] = cls_points[j]
+
+
+@wp.kernel
 def hash_listed_points(cls_count: wp.array(dtype=wp.int32), cls: wp.int32, cls_points: wp.array(dtype=wp.vec3d),
                        first: wp.int32, cell_inv: wp.float64, dim: wp.int32, keys: wp.array(dtype=wp.int32),
                        values: wp.array(dtype=wp.int32)):
