@@ -156,6 +156,22 @@ def compute_sample_cells(
     values[i] = i
 
 
+@wp.func
+def mark_cell_range(keys: wp.array(dtype=wp.int32), j: wp.int32, count: wp.int32, base: wp.int32,
+                    cell_starts: wp.array(dtype=wp.int32), cell_ends: wp.array(dtype=wp.int32)):
+    """After a stable sort by cell (keys, count of them): sorted position j opens or closes the range of its cell
+    keys[j] (stored at base + cell) where its neighbours' cells differ."""
+    c = keys[j]
+    if j == 0:
+        cell_starts[base + c] = j
+    elif keys[j - 1] != c:
+        cell_starts[base + c] = j
+    if j == count - 1:
+        cell_ends[base + c] = j + 1
+    elif keys[j + 1] != c:
+        cell_ends[base + c] = j + 1
+
+
 @wp.kernel
 def gather_sample_cells(
     keys: wp.array(dtype=wp.int32),
@@ -172,19 +188,11 @@ def gather_sample_cells(
     """After the (stable) sort by cell: each cell's range and its points in order, stored contiguously, with
     their codes (mark_pair_changes keeps the sign of sorted_code up to date)."""
     j = wp.tid()
-    c = keys[j]
     i = values[j]
     sorted_xy[j] = sample_xy[i]
     sorted_code[j] = sample_code[i]
     sample_pos[i] = j
-    if j == 0:
-        cell_starts[c] = j
-    elif keys[j - 1] != c:
-        cell_starts[c] = j
-    if j == count - 1:
-        cell_ends[c] = j + 1
-    elif keys[j + 1] != c:
-        cell_ends[c] = j + 1
+    mark_cell_range(keys, j, count, 0, cell_starts, cell_ends)
 
 
 

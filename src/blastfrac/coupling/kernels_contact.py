@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from blastfrac.cdem.contact_hash import cell_coord, cell_end, cell_wrap
+from blastfrac.cdem.contact_hash import cell_coord, cell_end, cell_wrap, mark_cell_range
 from blastfrac.mpm.bodies import MAT_GAS
 
 from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap,
@@ -159,17 +159,8 @@ def listed_cell_ranges(keys: wp.array(dtype=wp.int32), count: wp.int32, dim: wp.
                        starts: wp.array(dtype=wp.int32), ends: wp.array(dtype=wp.int32)):
     """After the stable sort by cell (keys, count of them): each cell's range of sorted positions."""
     j = wp.tid()
-    c = keys[j]
-    if c >= dim * dim:
-        return                                          # past the list's length
-    if j == 0:
-        starts[cbase + c] = j
-    elif keys[j - 1] != c:
-        starts[cbase + c] = j
-    if j == count - 1:
-        ends[cbase + c] = j + 1
-    elif keys[j + 1] != c:
-        ends[cbase + c] = j + 1
+    if keys[j] < dim * dim:                             # (not past the list's length)
+        mark_cell_range(keys, j, count, cbase, starts, ends)
 
 
 @wp.kernel
