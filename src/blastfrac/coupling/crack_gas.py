@@ -38,10 +38,12 @@ from __future__ import annotations
 import numpy as np
 import warp as wp
 
-from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasParticles,
+from .._warp import Launcher
+from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasHash, GasParticles,
                                 collect_cell_links, collect_mouths, crack_apply_flux, crack_cell_scale,
                                 crack_link_flux, crack_particle_scale, crack_refresh_particles, count_paths,
-                                note_paths, release_wide_cells, update_crack_cells)
+                                gas_hash_ranges, hash_burnt_particles, note_paths, release_wide_cells,
+                                update_crack_cells)
 
 
 def static_cell_links(pair_nodes: np.ndarray, node_vertex: np.ndarray, X: np.ndarray):
@@ -75,6 +77,17 @@ def static_cell_links(pair_nodes: np.ndarray, node_vertex: np.ndarray, X: np.nda
     return pairs, ends, dx, vert
 
 
+def hash_burnt(parts: GasParticles, hsh: GasHash, keys: wp.array, n: int, device, launch=wp.launch) -> None:
+    """File the active, fully burnt of the ``n`` particles ``parts`` in the cells of ``hsh`` (a stable sort by cell,
+    wp.HashGrid's order; nothing read back, so a graph can hold it). ``keys`` and ``hsh.values`` hold 2n entries
+    (the radix sort's scratch), ``hsh.starts``/``ends`` dim²; ``launch`` is wp.launch or a Launcher."""
+    launch(hash_burnt_particles, dim=n, inputs=[parts, hsh, keys], device=device)
+    wp.utils.radix_sort_pairs(keys, hsh.values, n)
+    hsh.starts.zero_()
+    hsh.ends.zero_()
+    launch(gas_hash_ranges, dim=n, inputs=[keys, n, hsh], device=device)
+
+
 #: a crack cell at or above this pressure [Pa] counts as pressurised in reports and figures
 PRESSURISED = 1e6
 
@@ -96,6 +109,7 @@ class CrackGas:
         self.model, self.mpm = model, mpm
         d = model.device
         self.device = d
+        self._launch = Launcher()                 # recorded launches (_warp.Launcher): ~10 a step
         topo = model.topology
         pn = topo.pair_nodes
         X = model.host["node_X"]
@@ -167,6 +181,16 @@ class CrackGas:
 
         # a cell open wider than this at both ends hands its gas to the MPM [m] (the particle spacing h/ppc)
         self.particle_size = float(mpm.spec.h / mpm.opts.ppc) if mpm is not None else 0.0
+        # the burnt particles' hash (GasHash), in which the mouths and the wide cells find their particle: cells as
+        # wide as the larger of the two search radii (the release's), about one per particle
+        hsh = GasHash()
+        dim = int(min(1024, max(16, np.sqrt(max(n, 1)))))
+        hsh.values = z(2 * n, wp.int32)
+        hsh.starts, hsh.ends = z(dim * dim, wp.int32), z(dim * dim, wp.int32)
+        hsh.cell_inv = 1.0 / (self.mouth_radius + self.particle_size) if n else 0.0
+        hsh.dim = dim
+        self.hash = hsh
+        self._hash_keys = z(2 * n, wp.int32)
         self._released = wp.zeros(1, dtype=wp.int32, device=d)           # cells released by this rebuild
         self._released_total = wp.zeros(1, dtype=wp.int32, device=d)     # ... by the run
         self.f_nodes = wp.zeros(max(1, model.node_count), dtype=wp.vec2d, device=d)   # this step's face loads [N/m]
@@ -190,29 +214,31 @@ class CrackGas:
         device; the host reads them outside a capture)."""
         d = self.device
         lk = self.links
+        if self.n_particles:
+            hash_burnt(self.parts, self.hash, self._hash_keys, self.n_particles, d, self._launch)
         if self.n_particles and self.particle_size > 0.0:
             self._released.zero_()
-            wp.launch(release_wide_cells, dim=self.Q,
-                      inputs=[self.cells, self.gas, self.parts, self.n_particles, state.x, state.v,
-                              wp.float64(self.particle_size), wp.float64(self.mouth_radius + self.particle_size),
-                              wp.float64(self._dt_prev), self._released, self._released_total], device=d)
-            refresh = lambda: wp.launch(crack_refresh_particles, dim=self.n_particles,
-                                        inputs=[self.parts, self.params], device=d)
+            self._launch(release_wide_cells, dim=self.Q,
+                         inputs=[self.cells, self.gas, self.parts, self.hash, state.x, state.v,
+                                 wp.float64(self.particle_size), wp.float64(self.mouth_radius + self.particle_size),
+                                 wp.float64(self._dt_prev), self._released, self._released_total], device=d)
+            refresh = lambda: self._launch(crack_refresh_particles, dim=self.n_particles,
+                                           inputs=[self.parts, self.params], device=d)
             if self.captured:
                 wp.capture_if(self._released, on_true=refresh)
             elif int(self._released.numpy()[0]):
                 refresh()
         lk.count.zero_()
         if self.n_static:
-            wp.launch(collect_cell_links, dim=self.n_static,
-                      inputs=[self.static_pairs, self.static_ends, self.static_dx, self.gas.wet, lk], device=d)
-        wp.launch(note_paths, dim=1, inputs=[lk.count, self._paths], device=d)
+            self._launch(collect_cell_links, dim=self.n_static,
+                         inputs=[self.static_pairs, self.static_ends, self.static_dx, self.gas.wet, lk], device=d)
+        self._launch(note_paths, dim=1, inputs=[lk.count, self._paths], device=d)
         if self.n_cand:
-            wp.launch(collect_mouths, dim=self.n_cand,
-                      inputs=[self.cand_cell, self.cand_end, self.cells, self.gas.wet, state.x, self.parts,
-                              self.n_particles, wp.float64(self.mouth_radius), wp.float64(self.particle_floor * 1.01), lk],
-                      device=d)
-        wp.launch(count_paths, dim=1, inputs=[lk.count, self._paths, self._mouths], device=d)
+            self._launch(collect_mouths, dim=self.n_cand,
+                         inputs=[self.cand_cell, self.cand_end, self.cells, self.gas.wet, state.x, self.parts,
+                                 self.hash, wp.float64(self.mouth_radius), wp.float64(self.particle_floor * 1.01), lk],
+                         device=d)
+        self._launch(count_paths, dim=1, inputs=[lk.count, self._paths, self._mouths], device=d)
         self._counts_stale = True
         if not self.captured:
             self._read_counts()
@@ -250,9 +276,9 @@ class CrackGas:
             self.rebuild(state)                   # (reads _dt_prev: before host_step moves it on)
         _, dt_prev = self.host_step(dt)
         self.f_nodes.zero_()
-        wp.launch(update_crack_cells, dim=self.Q,
-                  inputs=[self.cells, self.gas, self.params, state.pair_mode, state.x, state.v,
-                          wp.float64(dt_prev), wp.float64(dt), self.f_nodes], device=d)
+        self._launch(update_crack_cells, dim=self.Q,
+                     inputs=[self.cells, self.gas, self.params, state.pair_mode, state.x, state.v,
+                             wp.float64(dt_prev), wp.float64(dt), self.f_nodes], device=d)
         if self.captured:
             wp.capture_if(self.links.count, on_true=lambda: self._flow(dt))
             return
@@ -264,13 +290,15 @@ class CrackGas:
         """This step's flow along the paths and through the mouths (there is at least one path)."""
         d = self.device
         n = self.capacity if self.captured else self.n_links + self.n_mouths
-        wp.launch(crack_link_flux, dim=n, inputs=[self.links, self.gas, self.parts, self.params, wp.float64(dt)], device=d)
-        wp.launch(crack_cell_scale, dim=self.Q, inputs=[self.gas, self.params], device=d)
-        self._at_mouths(lambda: wp.launch(crack_particle_scale, dim=self.n_particles,
-                                          inputs=[self.parts, self.params, wp.float64(self.particle_floor)], device=d))
-        wp.launch(crack_apply_flux, dim=n, inputs=[self.links, self.gas, self.parts], device=d)
-        self._at_mouths(lambda: wp.launch(crack_refresh_particles, dim=self.n_particles,
-                                          inputs=[self.parts, self.params], device=d))
+        self._launch(crack_link_flux, dim=n, inputs=[self.links, self.gas, self.parts, self.params, wp.float64(dt)],
+                     device=d)
+        self._launch(crack_cell_scale, dim=self.Q, inputs=[self.gas, self.params], device=d)
+        self._at_mouths(lambda: self._launch(crack_particle_scale, dim=self.n_particles,
+                                             inputs=[self.parts, self.params, wp.float64(self.particle_floor)],
+                                             device=d))
+        self._launch(crack_apply_flux, dim=n, inputs=[self.links, self.gas, self.parts], device=d)
+        self._at_mouths(lambda: self._launch(crack_refresh_particles, dim=self.n_particles,
+                                             inputs=[self.parts, self.params], device=d))
 
     def _at_mouths(self, launch) -> None:
         """``launch()`` where the network has mouths: on the device's count in a capture, the host's outside."""
@@ -283,7 +311,7 @@ class CrackGas:
         """state.f += this step's crack-face loads."""
         from .kernels_contact import add_node_loads
 
-        wp.launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_nodes], device=self.device)
+        self._launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_nodes], device=self.device)
 
     # ------------------------------------------------------------------ verification hooks
     def set_cell_state(self, cells, mass, energy) -> None:

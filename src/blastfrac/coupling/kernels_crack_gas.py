@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import warp as wp
 
+from blastfrac.cdem.contact_hash import cell_coord, cell_end, cell_wrap, mark_cell_range
 from blastfrac.materials.crack_flow import crack_mass_flux
 from blastfrac.materials.jwl import V_FLOOR, jwl_pressure, jwl_sound_speed_sq
 
@@ -130,6 +131,19 @@ class GasParticles:
     touched: wp.array(dtype=wp.int32)
 
 
+@wp.struct
+class GasHash:
+    """The active, fully burnt gas points filed in a cell grid, rebuilt with the network (``hash_burnt_particles``):
+    wp.HashGrid's dim × dim cells of width 1/cell_inv [m], coordinates wrapped. The mouths and the wide cells look
+    for their particle in the cells within their search radius instead of over every particle."""
+
+    values: wp.array(dtype=wp.int32)     # particle indices sorted by cell (twice the particle count: the radix sort)
+    starts: wp.array(dtype=wp.int32)     # first sorted position of each of the dim² cells
+    ends: wp.array(dtype=wp.int32)       # one past its last (starts = ends = 0: an empty cell)
+    cell_inv: wp.float64                 # 1 / cell width [1/m]
+    dim: wp.int32                        # cells along x and y
+
+
 # ----------------------------------------------------------------------------- functions
 @wp.func
 def quad_area(x0: wp.vec2d, x1: wp.vec2d, x2: wp.vec2d, x3: wp.vec2d):
@@ -164,7 +178,59 @@ def products_state(m: wp.float64, e_int: wp.float64, vol: wp.float64, prm: Crack
     return wp.vec3d(p, wp.sqrt(c2), g)
 
 
+@wp.func
+def nearest_burnt(hsh: GasHash, parts: GasParticles, pt: wp.vec2d, radius: wp.float64, mass_floor: wp.float64):
+    """Index of the active, fully burnt particle nearest to pt [m] closer than ``radius`` [m], of mass above
+    ``mass_floor``·mass0 (a negative floor: any mass); −1 if none. It reads the cells that the disc of ``radius``
+    touches (3 × 3 where the cells are as wide as the radius), each at most once. Of equally near particles the
+    lowest index, so the answer is that of a search over every particle in index order."""
+    inv = hsh.cell_inv
+    dim = hsh.dim
+    cx0 = cell_coord((pt[0] - radius) * inv)
+    cy0 = cell_coord((pt[1] - radius) * inv)
+    cx1 = cell_end(cx0, cell_coord((pt[0] + radius) * inv), dim)
+    cy1 = cell_end(cy0, cell_coord((pt[1] + radius) * inv), dim)
+    best = int(-1)
+    d2best = radius * radius
+    for cy in range(cy0, cy1 + 1):
+        row = cell_wrap(cy, dim) * dim
+        for cx in range(cx0, cx1 + 1):
+            c = row + cell_wrap(cx, dim)
+            for j in range(hsh.starts[c], hsh.ends[c]):
+                r = hsh.values[j]
+                if parts.mass[r] <= mass_floor * parts.mass0[r]:
+                    continue
+                d = parts.x[r] - pt
+                d2 = wp.dot(d, d)
+                if d2 < d2best or (d2 == d2best and best >= 0 and r < best):
+                    d2best = d2
+                    best = r
+    return best
+
+
 # ----------------------------------------------------------------------------- kernels
+@wp.kernel
+def hash_burnt_particles(parts: GasParticles, hsh: GasHash, keys: wp.array(dtype=wp.int32)):
+    """keys[r], values[r] for the sort of the particles by cell (GasHash): the cell of an active, fully burnt
+    particle, dim² (after every cell) for the others."""
+    r = wp.tid()
+    key = hsh.dim * hsh.dim
+    if parts.active[r] != 0 and parts.burn[r] >= F64(1.0):
+        x = parts.x[r]
+        key = (cell_wrap(cell_coord(x[1] * hsh.cell_inv), hsh.dim) * hsh.dim
+               + cell_wrap(cell_coord(x[0] * hsh.cell_inv), hsh.dim))
+    keys[r] = key
+    hsh.values[r] = r
+
+
+@wp.kernel
+def gas_hash_ranges(keys: wp.array(dtype=wp.int32), count: wp.int32, hsh: GasHash):
+    """After the stable sort by cell: each cell's range of sorted positions."""
+    j = wp.tid()
+    if keys[j] < hsh.dim * hsh.dim:
+        mark_cell_range(keys, j, count, 0, hsh.starts, hsh.ends)
+
+
 @wp.kernel
 def update_crack_cells(cells: CrackCells, gas: CrackGasState, prm: CrackGasParams,
                        pair_mode: wp.array(dtype=wp.int32), x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d),
@@ -244,11 +310,10 @@ def collect_cell_links(pairs: wp.array(dtype=wp.vec2i), ends: wp.array(dtype=wp.
 
 @wp.kernel
 def collect_mouths(cand_cell: wp.array(dtype=wp.int32), cand_end: wp.array(dtype=wp.int32), cells: CrackCells,
-                   wet: wp.array(dtype=wp.int32), x: wp.array(dtype=wp.vec2d), parts: GasParticles, n_particles: int,
+                   wet: wp.array(dtype=wp.int32), x: wp.array(dtype=wp.vec2d), parts: GasParticles, hsh: GasHash,
                    radius: wp.float64, min_mass_fraction: wp.float64, links: CrackLinks):
     """A wet cell's end on a surface vertex (borehole wall, free face) with burnt gas within ``radius`` [m] of it
-    becomes a mouth, fed by the nearest fully burnt active particle above the mass floor (brute force over the
-    particles: the candidate ends are few)."""
+    becomes a mouth, fed by the nearest fully burnt active particle above the mass floor (``nearest_burnt``)."""
     k = wp.tid()
     q = cand_cell[k]
     if wet[q] != 1:
@@ -260,18 +325,7 @@ def collect_mouths(cand_cell: wp.array(dtype=wp.int32), cand_end: wp.array(dtype
         pt = F64(0.5) * (x[n[0]] + x[n[3]])
     else:
         pt = F64(0.5) * (x[n[1]] + x[n[2]])
-    best = int(-1)
-    d2best = radius * radius
-    for r in range(n_particles):
-        if parts.active[r] == 0 or parts.burn[r] < F64(1.0):
-            continue
-        if parts.mass[r] <= min_mass_fraction * parts.mass0[r]:
-            continue
-        d = parts.x[r] - pt
-        d2 = wp.dot(d, d)
-        if d2 < d2best:
-            d2best = d2
-            best = r
+    best = nearest_burnt(hsh, parts, pt, radius, min_mass_fraction)
     if best < 0:
         return
     i = wp.atomic_add(links.count, 0, 1)
@@ -462,7 +516,7 @@ def crack_refresh_particles(parts: GasParticles, prm: CrackGasParams):
 
 
 @wp.kernel
-def release_wide_cells(cells: CrackCells, gas: CrackGasState, parts: GasParticles, n_particles: int,
+def release_wide_cells(cells: CrackCells, gas: CrackGasState, parts: GasParticles, hsh: GasHash,
                        x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d), d_particle: wp.float64,
                        radius: wp.float64, dt_prev: wp.float64, released: wp.array(dtype=wp.int32),
                        released_total: wp.array(dtype=wp.int32)):
@@ -479,16 +533,7 @@ def release_wide_cells(cells: CrackCells, gas: CrackGasState, parts: GasParticle
         return
     n = cells.nodes[q]
     c = F64(0.25) * (x[n[0]] + x[n[1]] + x[n[2]] + x[n[3]])
-    best = int(-1)
-    d2best = radius * radius
-    for r in range(n_particles):
-        if parts.active[r] == 0 or parts.burn[r] < F64(1.0):
-            continue
-        d = parts.x[r] - c
-        d2 = wp.dot(d, d)
-        if d2 < d2best:
-            d2best = d2
-            best = r
+    best = nearest_burnt(hsh, parts, c, radius, F64(-1.0))
     if best < 0:
         return
     w_old = F64(0.0)
