@@ -32,7 +32,11 @@ CASES = {"demo": ("examples/circular_rock/demo.toml", ["geometry.mesh_size=0.006
          # refinement zone, 8,514 blocks); the example itself now ships 2.5 mm (113,690 blocks, mesh_study.md)
          # (and without the example's fracture band since stop 25, so that the figures compare across sessions)
          "confined_P0": ("examples/confined_blast/scenario_P0.toml", ["geometry.mesh_size=0.01",
-                                                                      "rock.fracture_band_width=0"])}
+                                                                      "rock.fracture_band_width=0"]),
+         # the same with the gas in the cracks (off by default; its cost: docs/scenario.md, [crack_gas])
+         "confined_P0_crack_gas": ("examples/confined_blast/scenario_P0.toml", ["geometry.mesh_size=0.01",
+                                                                                "rock.fracture_band_width=0",
+                                                                                "crack_gas.enabled=true"])}
 QUIET = ["output.paraview=false", "output.figures=false", "simulation.progress=false"]
 
 
@@ -65,7 +69,8 @@ def stage_times(sim, steps: int) -> dict:
 
     # launches replayed by the stages' recorders (_warp.Launcher) count too
     launchers = [o for o in (sim.cdem.launch, getattr(sim.cdem.contact, "_launch", None),
-                             getattr(sim.gas, "_launch", None), getattr(sim.coupler, "_launch", None)) if o is not None]
+                             getattr(sim.gas, "_launch", None), getattr(sim.coupler, "_launch", None),
+                             getattr(sim.crack_gas, "_launch", None)) if o is not None]
     replays0 = sum(o.replays for o in launchers)
     wp.launch = counting
     try:

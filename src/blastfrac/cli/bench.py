@@ -14,8 +14,8 @@ def add_parser(sub) -> None:
     p.add_argument("--quick", action="store_true", help="small sizes only (smoke run)")
     p.add_argument("--only", choices=("cdem", "mpm", "examples", "coupled"), default=None,
                    help="one suite; default: cdem and mpm ('examples' runs the paper's examples at full resolution, "
-                   "minutes; 'coupled' times the demo and confined P0 whole and per stage, intact and cracked, on 1 "
-                   "and 2 cores)")
+                   "minutes; 'coupled' times the demo, confined P0 and confined P0 with crack gas whole and per stage, "
+                   "intact and cracked, on 1 and 2 cores)")
     p.add_argument("--two-core-steps", type=int, default=1500, metavar="N",
                    help="with --only coupled: time the shipped confined P0 over N steps on one core and on two "
                         "threads (0: skip)")
