@@ -249,7 +249,7 @@ class GasRockCoupler:
             # the class's list in element order (a CPU appends it so; a GPU in any order)
             self._launch(listed_element_keys, n, [self.cls_count, c, self.cls_elems, c * E, E, self._keys,
                                                   self._order], device=m.device, key=c)
-            wp.utils.radix_sort_pairs(self._keys, self._order, n)
+            wp.utils.radix_sort_pairs(self._keys, self._order, n, end_bit=max(1, E.bit_length()))   # keys ≤ E
             self._launch(gather_listed, n, [self._order, self.cls_count, c, c * E, self.cls_elems, self.cls_points,
                                             self._tmp_elems, self._tmp_points], device=m.device, key=c)
             wp.copy(self.cls_elems, self._tmp_elems, dest_offset=c * E, count=n)
@@ -257,7 +257,7 @@ class GasRockCoupler:
             values, starts, ends = self._hash_views[c]
             self._launch(hash_listed_points, n, [self.cls_count, c, self.cls_points, c * E, wp.float64(1.0 / cell),
                                                  dim, self._keys, values], device=m.device, key=c)
-            wp.utils.radix_sort_pairs(self._keys, values, n)
+            wp.utils.radix_sort_pairs(self._keys, values, n, end_bit=(dim * dim).bit_length())     # keys ≤ dim²
             starts.zero_()
             ends.zero_()
             self._launch(listed_cell_ranges, n, [self._keys, n, dim, c * dim * dim, h.starts, h.ends],

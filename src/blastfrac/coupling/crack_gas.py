@@ -82,7 +82,7 @@ def hash_burnt(parts: GasParticles, hsh: GasHash, keys: wp.array, n: int, device
     wp.HashGrid's order; nothing read back, so a graph can hold it). ``keys`` and ``hsh.values`` hold 2n entries
     (the radix sort's scratch), ``hsh.starts``/``ends`` dim²; ``launch`` is wp.launch or a Launcher."""
     launch(hash_burnt_particles, dim=n, inputs=[parts, hsh, keys], device=device)
-    wp.utils.radix_sort_pairs(keys, hsh.values, n)
+    wp.utils.radix_sort_pairs(keys, hsh.values, n, end_bit=(hsh.dim * hsh.dim).bit_length())     # keys ≤ dim²
     hsh.starts.zero_()
     hsh.ends.zero_()
     launch(gas_hash_ranges, dim=n, inputs=[keys, n, hsh], device=device)
