@@ -6,7 +6,8 @@ them as particles. This stage carries the gas there as a network of *cells*, one
 
 * **Network.** A cell is an interface whose two springs have broken; cells sharing a mesh vertex are joined
   (all broken interfaces at a vertex meet in the void there). A cell end on a surface vertex (borehole wall,
-  free face) with fully burnt gas within ``mouth_radius`` of it is a *mouth*, fed by the nearest particle.
+  free face) with fully burnt gas within ``mouth_radius`` of it is a *mouth*, fed by the nearest particle (found
+  in a hash of the burnt particles built with the network, ``hash_burnt``).
   Intact interfaces hold no gas and pass none: gas reaches a cell only along broken ones.
 * **State.** Each cell holds a gas mass and internal energy in its volume (the area between its faces, at
   least ``min_aperture``·L); its pressure, sound speed and γ come from the products' JWL.
