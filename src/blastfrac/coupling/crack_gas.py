@@ -41,7 +41,7 @@ import warp as wp
 
 from .._warp import Launcher
 from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasHash, GasParticles,
-                                collect_cell_links, collect_mouths, crack_apply_flux, crack_cell_scale,
+                                collect_cell_links, collect_mouths, crack_apply_flux, crack_donor_scale,
                                 crack_link_flux, crack_particle_scale, crack_refresh_particles, count_paths,
                                 gas_hash_ranges, hash_burnt_particles, note_paths, release_wide_cells,
                                 update_crack_cells)
@@ -293,7 +293,7 @@ class CrackGas:
         n = self.capacity if self.captured else self.n_links + self.n_mouths
         self._launch(crack_link_flux, dim=n, inputs=[self.links, self.gas, self.parts, self.params, wp.float64(dt)],
                      device=d)
-        self._launch(crack_cell_scale, dim=self.Q, inputs=[self.gas, self.params], device=d)
+        self._launch(crack_donor_scale, dim=n, inputs=[self.links, self.gas, self.params], device=d)
         self._at_mouths(lambda: self._launch(crack_particle_scale, dim=self.n_particles,
                                              inputs=[self.parts, self.params, wp.float64(self.particle_floor)],
                                              device=d))

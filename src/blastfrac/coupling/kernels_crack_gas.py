@@ -433,9 +433,22 @@ def crack_link_flux(links: CrackLinks, gas: CrackGasState, parts: GasParticles, 
 
 
 @wp.kernel
-def crack_cell_scale(gas: CrackGasState, prm: CrackGasParams):
-    """Fraction of its asked outflow a cell can give: at most ``cell_fraction`` of its mass in one step."""
-    q = wp.tid()
+def crack_donor_scale(links: CrackLinks, gas: CrackGasState, prm: CrackGasParams):
+    """Fraction of its asked outflow a donor cell can give: at most ``cell_fraction`` of its mass in one step. Over
+    the paths, for the cell each one draws from (only a donor's fraction is read, by crack_apply_flux): a cell
+    that feeds several paths is written by each with the same value (its outflow and mass do not change in this
+    kernel), which spares a pass over every interface of the rock."""
+    k = wp.tid()
+    if k >= links.count[0]:
+        return
+    dm = links.dm[k]
+    q = int(-1)
+    if dm > F64(0.0):
+        q = links.a[k]
+    elif dm < F64(0.0):
+        q = links.b[k]
+    if q < 0:
+        return                                    # no flow, or a particle gives (crack_particle_scale)
     o = gas.out[q]
     s = F64(1.0)
     lim = prm.cell_fraction * gas.mass[q]
