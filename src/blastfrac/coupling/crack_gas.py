@@ -40,7 +40,8 @@ import numpy as np
 import warp as wp
 
 from .._warp import Launcher
-from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, GasHash, GasParticles,
+from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, FaceLoads, GasHash,
+                                GasParticles, add_face_loads, clear_face_loads,
                                 collect_cell_links, collect_mouths, crack_apply_flux, crack_donor_scale,
                                 crack_link_flux, crack_particle_scale, crack_refresh_particles, count_paths,
                                 gas_hash_ranges, hash_burnt_particles, note_paths, release_wide_cells,
@@ -194,7 +195,11 @@ class CrackGas:
         self._hash_keys = z(2 * n, wp.int32)
         self._released = wp.zeros(1, dtype=wp.int32, device=d)           # cells released by this rebuild
         self._released_total = wp.zeros(1, dtype=wp.int32, device=d)     # ... by the run
-        self.f_nodes = wp.zeros(max(1, model.node_count), dtype=wp.vec2d, device=d)   # this step's face loads [N/m]
+        # this step's face loads [N/m] and the nodes that carry them (FaceLoads: the add and the clearing visit those)
+        nn = max(1, model.node_count)
+        self.loads = FaceLoads()
+        self.loads.f, self.loads.mark = wp.zeros(nn, dtype=wp.vec2d, device=d), wp.zeros(nn, dtype=wp.int32, device=d)
+        self.loads.nodes, self.loads.count = wp.zeros(nn, dtype=wp.int32, device=d), wp.zeros(1, dtype=wp.int32, device=d)
         self._paths = wp.zeros(1, dtype=wp.int32, device=d)              # cell–cell paths of the last rebuild
         self._mouths = wp.zeros(1, dtype=wp.int32, device=d)             # its mouths (paths to particles)
         self.n_links = 0                      # the two counts as the host last read them (outside a capture)
@@ -270,16 +275,17 @@ class CrackGas:
         self._since, self._dt_prev = saved
 
     def apply(self, state, dt: float) -> None:
-        """Stage between the particle–edge contact and P2G: cell pressures and face forces (into f_nodes;
+        """Stage between the particle–edge contact and P2G: cell pressures and face forces (into ``loads``;
         ``add_loads`` adds them to state.f), then this step's flow along the network and at the mouths."""
         d = self.device
         if self._since >= self.rebuild_interval:
             self.rebuild(state)                   # (reads _dt_prev: before host_step moves it on)
         _, dt_prev = self.host_step(dt)
-        self.f_nodes.zero_()
+        self._launch(clear_face_loads, dim=self._loaded_dim(), inputs=[self.loads], device=d)   # the last step's
+        self.loads.count.zero_()
         self._launch(update_crack_cells, dim=self.Q,
                      inputs=[self.cells, self.gas, self.params, state.pair_mode, state.x, state.v,
-                             wp.float64(dt_prev), wp.float64(dt), self.f_nodes], device=d)
+                             wp.float64(dt_prev), wp.float64(dt), self.loads], device=d)
         if self.captured:
             wp.capture_if(self.links.count, on_true=lambda: self._flow(dt))
             return
@@ -309,10 +315,15 @@ class CrackGas:
             launch()
 
     def add_loads(self, state) -> None:
-        """state.f += this step's crack-face loads."""
-        from .kernels_contact import add_node_loads
+        """state.f += this step's crack-face loads (at the nodes that carry one)."""
+        self._launch(add_face_loads, dim=self._loaded_dim(), inputs=[state.f, self.loads], device=self.device)
 
-        self._launch(add_node_loads, dim=self.model.node_count, inputs=[state.f, self.f_nodes], device=self.device)
+    def _loaded_dim(self) -> int:
+        """Threads for a pass over the loaded nodes: their count on a CPU outside a capture (a view, nothing waits),
+        else every node (the threads beyond the count return)."""
+        if self.captured or not wp.get_device(self.device).is_cpu:
+            return max(1, self.model.node_count)
+        return int(self.loads.count.numpy()[0])
 
     # ------------------------------------------------------------------ verification hooks
     def set_cell_state(self, cells, mass, energy) -> None:

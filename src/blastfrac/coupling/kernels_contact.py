@@ -460,13 +460,6 @@ def add_reactions_with_work(
             wp.atomic_add(acc, ACC_ABSORBED, -w * wp.dot(a, v[n]))
 
 
-@wp.kernel
-def add_node_loads(f: wp.array(dtype=wp.vec2d), a: wp.array(dtype=wp.vec2d)):
-    """f += a [N/m] (the gas loads on the rock nodes, added after the rock's own forces in a fixed order)."""
-    i = wp.tid()
-    f[i] = f[i] + a[i]
-
-
 @wp.func
 def contact_heat(acc: wp.array(dtype=wp.float64)):
     """Q [J/m]: what the contacts have dissipated and not yet handed on, max(absorbed − stored, 0), when some gas

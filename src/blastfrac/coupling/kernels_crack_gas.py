@@ -132,6 +132,18 @@ class GasParticles:
 
 
 @wp.struct
+class FaceLoads:
+    """This step's crack-face loads and the nodes that carry them: update_crack_cells adds each wet cell's face
+    forces into f and lists each node the first time it loads it (mark), so that adding them to the rock
+    (add_face_loads) and clearing them for the next step (clear_face_loads) visit those nodes only, not the rock's."""
+
+    f: wp.array(dtype=wp.vec2d)          # face load of each node [N/m]
+    mark: wp.array(dtype=wp.int32)       # 1: the node is in the list
+    nodes: wp.array(dtype=wp.int32)      # the loaded nodes, count[0] of them (capacity: every node)
+    count: wp.array(dtype=wp.int32)
+
+
+@wp.struct
 class GasHash:
     """The active, fully burnt gas points filed in a cell grid, rebuilt with the network (``hash_burnt_particles``):
     wp.HashGrid's dim × dim cells of width 1/cell_inv [m], coordinates wrapped. The mouths and the wide cells look
@@ -208,6 +220,14 @@ def nearest_burnt(hsh: GasHash, parts: GasParticles, pt: wp.vec2d, radius: wp.fl
     return best
 
 
+@wp.func
+def add_face_load(loads: FaceLoads, n: int, f: wp.vec2d):
+    """loads.f[n] += f [N/m], and node n listed once (its mark taken atomically: one thread lists it)."""
+    wp.atomic_add(loads.f, n, f)
+    if wp.atomic_add(loads.mark, n, 1) == 0:
+        loads.nodes[wp.atomic_add(loads.count, 0, 1)] = n
+
+
 # ----------------------------------------------------------------------------- kernels
 @wp.kernel
 def hash_burnt_particles(parts: GasParticles, hsh: GasHash, keys: wp.array(dtype=wp.int32)):
@@ -234,7 +254,7 @@ def gas_hash_ranges(keys: wp.array(dtype=wp.int32), count: wp.int32, hsh: GasHas
 @wp.kernel
 def update_crack_cells(cells: CrackCells, gas: CrackGasState, prm: CrackGasParams,
                        pair_mode: wp.array(dtype=wp.int32), x: wp.array(dtype=wp.vec2d), v: wp.array(dtype=wp.vec2d),
-                       dt_prev: wp.float64, dt: wp.float64, f: wp.array(dtype=wp.vec2d)):
+                       dt_prev: wp.float64, dt: wp.float64, loads: FaceLoads):
     """Volume, openings, pressure and face forces of each wet cell; the gas pays the forces' work.
 
     Work: ½dt_prev·Σ f_old·v for the last step's forces (second half) and ½dt·Σ f_new·v for this step's (first
@@ -281,16 +301,37 @@ def update_crack_cells(cells: CrackCells, gas: CrackGasState, prm: CrackGasParam
     gas.force[4 * q + 2] = f2
     gas.force[4 * q + 3] = f3
     if p > F64(0.0):
-        wp.atomic_add(f, n[0], f0)
-        wp.atomic_add(f, n[1], f1)
-        wp.atomic_add(f, n[2], f2)
-        wp.atomic_add(f, n[3], f3)
+        add_face_load(loads, n[0], f0)
+        add_face_load(loads, n[1], f1)
+        add_face_load(loads, n[2], f2)
+        add_face_load(loads, n[3], f3)
     gas.vol[q] = vol
     gas.gap[q] = gap
     gas.pres[q] = p
     gas.cs[q] = s[1]
     gas.gamma[q] = s[2]
     gas.out[q] = F64(0.0)
+
+
+@wp.kernel
+def add_face_loads(f: wp.array(dtype=wp.vec2d), loads: FaceLoads):
+    """f += this step's face loads [N/m], at the listed nodes (threads beyond the list's length return)."""
+    i = wp.tid()
+    if i >= loads.count[0]:
+        return
+    n = loads.nodes[i]
+    f[n] = f[n] + loads.f[n]
+
+
+@wp.kernel
+def clear_face_loads(loads: FaceLoads):
+    """The last step's loads and marks back to 0 at the nodes it listed (threads beyond its length return)."""
+    i = wp.tid()
+    if i >= loads.count[0]:
+        return
+    n = loads.nodes[i]
+    loads.f[n] = wp.vec2d(F64(0.0), F64(0.0))
+    loads.mark[n] = 0
 
 
 @wp.kernel
