@@ -126,6 +126,22 @@ def cell_end(start: wp.int32, end: wp.int32, dim: wp.int32):
     return out
 
 
+@wp.func
+def hash_cell(x: wp.float64, y: wp.float64, inv: wp.float64, dim: wp.int32):
+    """Row-major index of the wrapped cell (dim × dim cells of width 1/inv [m]) that wp.HashGrid files (x, y) [m] in."""
+    return cell_wrap(cell_coord(y * inv), dim) * dim + cell_wrap(cell_coord(x * inv), dim)
+
+
+@wp.func
+def query_cells(p: wp.vec2d, radius: wp.float64, inv: wp.float64, dim: wp.int32):
+    """(first x, last x, first y, last y) cell coordinates of a query of ``radius`` [m] around p [m] in cells of
+    width 1/inv [m]: the cells wp.HashGrid's query visits, each wrapped cell at most once (cell_end)."""
+    xs = cell_coord((p[0] - radius) * inv)
+    ys = cell_coord((p[1] - radius) * inv)
+    return wp.vec4i(xs, cell_end(xs, cell_coord((p[0] + radius) * inv), dim),
+                    ys, cell_end(ys, cell_coord((p[1] + radius) * inv), dim))
+
+
 @wp.kernel
 def compute_sample_cells(
     x: wp.array(dtype=wp.vec2d),
@@ -152,7 +168,7 @@ def compute_sample_cells(
     if slot_exposed(s, slot_iface, pair_mode):
         code = s + 1
     sample_code[i] = code
-    keys[i] = cell_wrap(cell_coord(m[1] * cell_inv), dim) * dim + cell_wrap(cell_coord(m[0] * cell_inv), dim)
+    keys[i] = hash_cell(m[0], m[1], cell_inv, dim)
     values[i] = i
 
 
@@ -271,13 +287,10 @@ def hash_search(
     r2 = radius * radius
     if use_cache != 0:
         dim = hsh.cell_dim
-        xs = cell_coord((xn[0] - radius) * hsh.cell_inv)
-        xe = cell_end(xs, cell_coord((xn[0] + radius) * hsh.cell_inv), dim)
-        ys = cell_coord((xn[1] - radius) * hsh.cell_inv)
-        ye = cell_end(ys, cell_coord((xn[1] + radius) * hsh.cell_inv), dim)
-        for cy in range(ys, ye + 1):
+        cr = query_cells(xn, radius, hsh.cell_inv, dim)
+        for cy in range(cr[2], cr[3] + 1):
             row = cell_wrap(cy, dim) * dim
-            for cx in range(xs, xe + 1):
+            for cx in range(cr[0], cr[1] + 1):
                 c = row + cell_wrap(cx, dim)
                 for j in range(hsh.cell_starts[c], hsh.cell_ends[c]):
                     code = hsh.sorted_code[j]

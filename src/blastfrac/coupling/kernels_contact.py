@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from blastfrac.cdem.contact_hash import cell_coord, cell_end, cell_wrap, mark_cell_range
+from blastfrac.cdem.contact_hash import cell_wrap, hash_cell, mark_cell_range, query_cells
 from blastfrac.mpm.bodies import MAT_GAS
 
 from .particle_edge import (CONTACT_HISTORY, contact_force, edge_overlap, initial_overlap, normal_force_cap,
@@ -149,7 +149,7 @@ def hash_listed_points(cls_count: wp.array(dtype=wp.int32), cls: wp.int32, cls_p
     key = dim * dim
     if k < cls_count[cls]:
         c = cls_points[first + k]
-        key = cell_wrap(cell_coord(c[1] * cell_inv), dim) * dim + cell_wrap(cell_coord(c[0] * cell_inv), dim)
+        key = hash_cell(c[0], c[1], cell_inv, dim)
     keys[k] = key
     values[k] = k
 
@@ -262,13 +262,10 @@ def eval_particle_edge_contact(
         # the cells wp.HashGrid's search would visit, in its order, each cell's points in list order
         dim = hsh.dim
         inv = hsh.cell_inv[cls]
-        xs = cell_coord((xp[0] - query_radius) * inv)
-        xe = cell_end(xs, cell_coord((xp[0] + query_radius) * inv), dim)
-        ys = cell_coord((xp[1] - query_radius) * inv)
-        ye = cell_end(ys, cell_coord((xp[1] + query_radius) * inv), dim)
-        for cy in range(ys, ye + 1):
+        cr = query_cells(xp, query_radius, inv, dim)
+        for cy in range(cr[2], cr[3] + 1):
             row = cls * dim * dim + cell_wrap(cy, dim) * dim
-            for cx in range(xs, xe + 1):
+            for cx in range(cr[0], cr[1] + 1):
                 cc = row + cell_wrap(cx, dim)
                 for j in range(hsh.starts[cc], hsh.ends[cc]):
                     idx = hsh.values[cls * hsh.stride + j]

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from blastfrac.cdem.contact_hash import cell_coord, cell_end, cell_wrap, mark_cell_range
+from blastfrac.cdem.contact_hash import cell_wrap, hash_cell, mark_cell_range, query_cells
 from blastfrac.materials.crack_flow import crack_mass_flux
 from blastfrac.materials.jwl import V_FLOOR, jwl_pressure, jwl_sound_speed_sq
 
@@ -198,15 +198,12 @@ def nearest_burnt(hsh: GasHash, parts: GasParticles, pt: wp.vec2d, radius: wp.fl
     lowest index, so the answer is that of a search over every particle in index order."""
     inv = hsh.cell_inv
     dim = hsh.dim
-    cx0 = cell_coord((pt[0] - radius) * inv)
-    cy0 = cell_coord((pt[1] - radius) * inv)
-    cx1 = cell_end(cx0, cell_coord((pt[0] + radius) * inv), dim)
-    cy1 = cell_end(cy0, cell_coord((pt[1] + radius) * inv), dim)
+    cr = query_cells(pt, radius, inv, dim)
     best = int(-1)
     d2best = radius * radius
-    for cy in range(cy0, cy1 + 1):
+    for cy in range(cr[2], cr[3] + 1):
         row = cell_wrap(cy, dim) * dim
-        for cx in range(cx0, cx1 + 1):
+        for cx in range(cr[0], cr[1] + 1):
             c = row + cell_wrap(cx, dim)
             for j in range(hsh.starts[c], hsh.ends[c]):
                 r = hsh.values[j]
@@ -237,8 +234,7 @@ def hash_burnt_particles(parts: GasParticles, hsh: GasHash, keys: wp.array(dtype
     key = hsh.dim * hsh.dim
     if parts.active[r] != 0 and parts.burn[r] >= F64(1.0):
         x = parts.x[r]
-        key = (cell_wrap(cell_coord(x[1] * hsh.cell_inv), hsh.dim) * hsh.dim
-               + cell_wrap(cell_coord(x[0] * hsh.cell_inv), hsh.dim))
+        key = hash_cell(x[0], x[1], hsh.cell_inv, hsh.dim)
     keys[r] = key
     hsh.values[r] = r
 
