@@ -40,12 +40,12 @@ import numpy as np
 import warp as wp
 
 from .._warp import Launcher
+from .kernels_contact import listed_cell_ranges
 from .kernels_crack_gas import (CrackCells, CrackGasParams, CrackGasState, CrackLinks, FaceLoads, GasHash,
-                                GasParticles, add_face_loads, clear_face_loads,
-                                collect_cell_links, collect_mouths, crack_apply_flux, crack_donor_scale,
-                                crack_link_flux, crack_particle_scale, crack_refresh_particles, count_paths,
-                                gas_hash_ranges, hash_burnt_particles, note_paths, release_wide_cells,
-                                update_crack_cells)
+                                GasParticles, add_face_loads, clear_face_loads, collect_cell_links, collect_mouths,
+                                count_paths, crack_apply_flux, crack_donor_scale, crack_link_flux,
+                                crack_particle_scale, crack_refresh_particles, hash_burnt_particles, note_paths,
+                                release_wide_cells, update_crack_cells)
 
 
 def static_cell_links(pair_nodes: np.ndarray, node_vertex: np.ndarray, X: np.ndarray):
@@ -87,7 +87,7 @@ def hash_burnt(parts: GasParticles, hsh: GasHash, keys: wp.array, n: int, device
     wp.utils.radix_sort_pairs(keys, hsh.values, n, end_bit=(hsh.dim * hsh.dim).bit_length())     # keys ≤ dim²
     hsh.starts.zero_()
     hsh.ends.zero_()
-    launch(gas_hash_ranges, dim=n, inputs=[keys, n, hsh], device=device)
+    launch(listed_cell_ranges, dim=n, inputs=[keys, n, hsh.dim, 0, hsh.starts, hsh.ends], device=device)
 
 
 #: a crack cell at or above this pressure [Pa] counts as pressurised in reports and figures

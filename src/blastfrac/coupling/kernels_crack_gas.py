@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import warp as wp
 
-from blastfrac.cdem.contact_hash import cell_wrap, hash_cell, mark_cell_range, query_cells
+from blastfrac.cdem.contact_hash import cell_wrap, hash_cell, query_cells
 from blastfrac.materials.crack_flow import crack_mass_flux
 from blastfrac.materials.jwl import V_FLOOR, jwl_pressure, jwl_sound_speed_sq
 
@@ -237,14 +237,6 @@ def hash_burnt_particles(parts: GasParticles, hsh: GasHash, keys: wp.array(dtype
         key = hash_cell(x[0], x[1], hsh.cell_inv, hsh.dim)
     keys[r] = key
     hsh.values[r] = r
-
-
-@wp.kernel
-def gas_hash_ranges(keys: wp.array(dtype=wp.int32), count: wp.int32, hsh: GasHash):
-    """After the stable sort by cell: each cell's range of sorted positions."""
-    j = wp.tid()
-    if keys[j] < hsh.dim * hsh.dim:
-        mark_cell_range(keys, j, count, 0, hsh.starts, hsh.ends)
 
 
 @wp.kernel
