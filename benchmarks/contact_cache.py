@@ -14,6 +14,7 @@ kept, which is the least disturbed by other load on the machine. Usage::
 
     python benchmarks/contact_cache.py [--steps 200] [--rounds 3] [--scenario examples/circular_rock/demo.toml]
                                        [--baseline REV]   # also contact.py as it is at git revision REV
+                                       [--where]          # also each kernel, and the contact pass by node class
 """
 
 from __future__ import annotations
@@ -105,6 +106,111 @@ def held_counts(sim) -> dict:
             "held": int((cand & ~op).sum()), "contacts": int(c.active_count())}
 
 
+def kernel_times(sim, snap: dict, steps: int) -> dict[str, float]:
+    """ms per step of each kernel of the rock step (forces + integrate) from the state ``snap``, each launch timed
+    on its own (a CPU launch returns once its kernel has run; on a GPU these would be launch times, not kernel
+    times)."""
+    from collections import defaultdict
+
+    import warp as wp
+
+    from blastfrac import _warp as bw
+
+    _restore(sim, snap)
+    sim.cdem.contact.active = True
+    _time_steps(sim, 3, warm=0)                  # the records and the hash of this state, untimed
+    acc: dict[str, float] = defaultdict(float)
+    replay0, launch0 = bw.Launcher._replay, wp.launch
+
+    def replay(self, rec):
+        t = time.perf_counter()
+        replay0(self, rec)
+        acc[rec[0].kernel.key] += time.perf_counter() - t
+
+    def launch(kernel, *a, **k):
+        t = time.perf_counter()
+        out = launch0(kernel, *a, **k)
+        if not k.get("record_cmd"):
+            acc[kernel.key] += time.perf_counter() - t
+        return out
+
+    bw.Launcher._replay, wp.launch = replay, launch
+    try:
+        _time_steps(sim, steps, warm=0)
+    finally:
+        bw.Launcher._replay, wp.launch = replay0, launch0
+    return {k: v / steps * 1e3 for k, v in sorted(acc.items(), key=lambda kv: -kv[1])}
+
+
+def _woken(elem_near: np.ndarray, step: int, window: int) -> np.ndarray:
+    """contact_fan.node_woken of every element, in NumPy."""
+    from blastfrac.cdem.contact_fan import WAKE_FLAG
+
+    v = elem_near.astype(np.int64)
+    flagged = v >= WAKE_FLAG
+    base = np.where(flagged, v - WAKE_FLAG, v)
+    return np.where(flagged & (base == step), True,
+                    np.where(~flagged & (v == step), False, (base >= step - window) & (base < step)))
+
+
+PASS_ARRAYS = ("contact_slot", "contact_state", "elem_near", "query_after", "loss_acc")
+
+
+def pass_by_class(sim, snap: dict, reps: int = 30) -> list[tuple[str, int, float]]:
+    """The contact pass (eval_block_contact) of the state ``snap`` over its listed nodes, all and by what each
+    does (contact_kernels.node_contact): an open node searching the hash, an open one that is quiet (its own
+    vertex only), a held node whose block is woken (a hash search over every edge near it), a held one in
+    contact, a held one listed without contact. Each class is run as a list of its own, ``reps`` times from the
+    same contact history; (class, nodes, median ms a pass less that of an empty list, the launch's own cost,
+    which is the first row)."""
+    import warp as wp
+
+    from blastfrac.cdem.contact_kernels import eval_block_contact
+
+    _restore(sim, snap)
+    c, st = sim.cdem.contact, sim.state
+    c.active = True
+    _time_steps(sim, 3, warm=0)                  # the last of these is the pass that is timed again
+    listed = c._node_list.numpy()[: int(c._counts.numpy()[1])].copy()
+    step = int(c._clock.numpy()[0])
+    flag = c.node_flag.numpy()[listed]
+    in_contact = c.contact_slot.numpy()[listed] >= 0
+    woken = _woken(c.elem_near.numpy(), step, int(c.near_window))[listed // 3]
+    searching = woken | (c.query_after.numpy()[listed] <= step) | in_contact
+    classes = [("none (the launch itself)", np.zeros(len(listed), bool)),
+               ("all listed", np.ones(len(listed), bool)),
+               ("open, searching the hash", (flag == 2) & searching),
+               ("open, quiet", (flag == 2) & ~searching),
+               ("held, block woken", (flag == 1) & woken),
+               ("held, in contact", (flag == 1) & ~woken & in_contact),
+               ("held, no contact", (flag == 1) & ~woken & ~in_contact)]
+    keep = {k: getattr(c, k).numpy().copy() for k in PASS_ARRAYS}
+    f0, e0 = st.f.numpy().copy(), st.energy_acc.numpy().copy()
+    prm = c._params()
+    out = []
+    for name, mask in classes:
+        sub = wp.array(listed[mask].astype(np.int32), dtype=wp.int32, device=st.x.device)
+        counts = wp.array([0, int(mask.sum())], dtype=wp.int32, device=st.x.device)
+        times = []
+        for _ in range(reps):
+            for k, a in keep.items():
+                getattr(c, k).assign(a)
+            wp.synchronize()
+            t = time.perf_counter()
+            wp.launch(eval_block_contact, dim=1, inputs=[sub, counts, 0, 1, 1, c.s_mesh, c.s_hash, c.s_cache,
+                                                         c.s_hist, prm, st.pair_mode, st.pair_dropped, st.x, st.v,
+                                                         c._clock, float(sim.dt), c.s_rec, st.f, st.energy_acc],
+                      device=st.x.device)
+            wp.synchronize()
+            times.append(time.perf_counter() - t)
+        ms = float(np.median(times)) * 1e3
+        out.append((name, int(mask.sum()), ms - (out[0][2] if out else 0.0)))
+    st.f.assign(f0)
+    st.energy_acc.assign(e0)
+    _restore(sim, snap)
+    return out
+
+
 def load_baseline(rev: str):
     """BlockContact of src/blastfrac/cdem/contact.py at git revision rev (e.g. the commit before the cache), as a
     module of the package so that its relative imports work."""
@@ -127,7 +233,7 @@ def load_baseline(rev: str):
 
 
 def run(scenario: str = "examples/circular_rock/demo.toml", steps: int = 200, rounds: int = 3,
-        device: str = "cpu", baseline: str | None = None) -> dict:
+        device: str = "cpu", baseline: str | None = None, where: bool = False) -> dict:
     import tempfile
 
     import warp as wp
@@ -177,6 +283,11 @@ def run(scenario: str = "examples/circular_rock/demo.toml", steps: int = 200, ro
             wall[key], cpu[key] = min(wall[key], w), min(cpu[key], u)
     for sim, contact in ((intact, cfgs[0][2]), (cracked, cfgs[2][2])):
         sim.cdem.contact, contact.fan_cache = contact, True
+    split = {}
+    if where and device == "cpu":                # where the cracked step's extra time goes (CPU only)
+        split = {"kernels": {"intact": kernel_times(intact, snap_i, steps),
+                             "cracked": kernel_times(cracked, snap_c, steps)},
+                 "pass_classes": pass_by_class(cracked, snap_c)}
     ratios = {"cached": ("cracked_cached", "intact"), "uncached": ("cracked_uncached", "intact"),
               "graph": ("cracked_graph", "intact_graph")}
     if baseline:
@@ -188,7 +299,7 @@ def run(scenario: str = "examples/circular_rock/demo.toml", steps: int = 200, ro
             "ms_per_step": wall, "cpu_ms_per_step": cpu,
             "ratio": {k: wall[a] / wall[b] for k, (a, b) in ratios.items()},
             "cpu_ratio": {k: cpu[a] / cpu[b] for k, (a, b) in ratios.items()},
-            "load_before": load0, "load_after": os.getloadavg(), "cpus": os.cpu_count()}
+            "load_before": load0, "load_after": os.getloadavg(), "cpus": os.cpu_count(), **split}
 
 
 def main(argv=None) -> None:
@@ -199,8 +310,11 @@ def main(argv=None) -> None:
     p.add_argument("--device", default="cpu")
     p.add_argument("--baseline", default=None, metavar="REV",
                    help="also time contact.py as it is at git revision REV (e.g. the commit before the cache)")
+    p.add_argument("--where", action="store_true",
+                   help="also time each kernel of the intact and the cracked rock step, and the cracked state's "
+                        "contact pass by what its listed nodes do (CPU only)")
     a = p.parse_args(argv)
-    r = run(a.scenario, a.steps, a.rounds, a.device, a.baseline)
+    r = run(a.scenario, a.steps, a.rounds, a.device, a.baseline, a.where)
     t, u, rw, ru = r["ms_per_step"], r["cpu_ms_per_step"], r["ratio"], r["cpu_ratio"]
     print(f"{r['scenario']}: {r['elements']:,} elements, demo {r['demo_steps']} steps in {r['demo_wall_s']:.1f} s; "
           f"end state: {100 * r['broken_fraction']:.1f} % of springs broken, {100 * r['dropped_fraction']:.2f} % "
@@ -219,6 +333,21 @@ def main(argv=None) -> None:
         if ratio:
             line += f"   cracked/intact {rw[ratio]:.2f} wall, {ru[ratio]:.2f} CPU"
         print(line)
+    if "kernels" in r:
+        ki, kc = r["kernels"]["intact"], r["kernels"]["cracked"]
+        print(f"each kernel of the rock step, {r['steps']} steps, each launch timed [ms/step]: intact, cracked, "
+              "cracked - intact")
+        for k in sorted(set(ki) | set(kc), key=lambda k: -kc.get(k, 0.0)):
+            a_, b_ = ki.get(k, 0.0), kc.get(k, 0.0)
+            if max(a_, b_) >= 0.001:
+                print(f"  {k:32s} {a_:7.3f} {b_:7.3f} {b_ - a_:+7.3f}")
+        print(f"  {'sum':32s} {sum(ki.values()):7.3f} {sum(kc.values()):7.3f} "
+              f"{sum(kc.values()) - sum(ki.values()):+7.3f}")
+        print("the cracked state's contact pass by what its listed nodes do (each class alone, median, less the "
+              "launch's own cost in the first row) [ms/pass]:")
+        for name, count, ms in r["pass_classes"]:
+            per = f"{1e6 * ms / count:7.0f} ns a node" if count else ""
+            print(f"  {name:28s} {count:6,d} nodes {ms:7.3f} ms {per}")
     print(f"load average {r['load_before'][0]:.2f} before, {r['load_after'][0]:.2f} after ({r['cpus']} CPUs)")
 
 
