@@ -170,7 +170,9 @@ def pass_by_class(sim, snap: dict, reps: int = 30) -> list[tuple[str, int, float
     _restore(sim, snap)
     c, st = sim.cdem.contact, sim.state
     c.active = True
-    _time_steps(sim, 3, warm=0)                  # the last of these is the pass that is timed again
+    # the last of these steps' passes is timed again, from the contact history it left (its quiet windows too, so
+    # the classes below are what the timed passes do)
+    _time_steps(sim, 3, warm=0)
     listed = c._node_list.numpy()[: int(c._counts.numpy()[1])].copy()
     step = int(c._clock.numpy()[0])
     flag = c.node_flag.numpy()[listed]
